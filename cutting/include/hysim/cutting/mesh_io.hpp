@@ -1,0 +1,21 @@
+#pragma once
+// Mesh files: Gmsh MSH 2.2 ASCII (read/write; physical tag = material) and legacy VTK
+// ASCII unstructured grid (read/write). Errors name the file and line.
+#include <string>
+#include <variant>
+
+#include "hysim/cutting/mesh.hpp"
+
+namespace hysim::cutting {
+
+// Reads a tet mesh: the file's tetrahedra (MSH type 4 / VTK cell type 10). Other elements
+// are ignored. Unused nodes are kept. Fails on a file without tetrahedra.
+Result<TetMesh> readTetMesh(const std::string& path);
+// Reads a triangle mesh: the file's triangles (MSH type 2 / VTK cell type 5).
+Result<TriMesh> readTriMesh(const std::string& path);
+
+// Format chosen by extension: .msh or .vtk.
+Status writeMesh(const std::string& path, const TetMesh& mesh);
+Status writeMesh(const std::string& path, const TriMesh& mesh);
+
+}  // namespace hysim::cutting

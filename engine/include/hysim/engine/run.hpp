@@ -1,0 +1,42 @@
+#pragma once
+// The fixed-step loop: steps a Simulation for a number of steps, hands a snapshot to a
+// frame callback every k steps, and measures. Real-time pacing is the app's job, not this.
+#include <cstdint>
+#include <functional>
+#include <string>
+
+#include "hysim/engine/simulation.hpp"
+
+namespace hysim::engine {
+
+struct RunOptions {
+  int steps = -1;  // -1: the scene's
+  int every = -1;  // -1: the scene's render.every
+  // Called with the snapshot every `every` steps (and at step 0); an error stops the run.
+  std::function<Status(const render::RenderSnapshot&, int frame_index)> on_frame;
+};
+
+struct RunReport {
+  std::string scene;
+  std::string integrator;
+  int steps = 0;
+  double dt = 0.0;             // s
+  int nodes = 0, elements = 0, springs = 0, anchored = 0;
+  int substeps = 1;
+  double critical_dt = 0.0;    // s
+  double step_us_median = 0.0, step_us_p99 = 0.0, step_us_max = 0.0;
+  int frames = 0;
+  double frame_ms_median = 0.0;  // time spent in the frame callback (render + PNG)
+  std::uint64_t state_hash = 0;
+  int warnings = 0;
+  double max_tool_force_n = 0.0;
+  double wall_s = 0.0;
+};
+
+Result<RunReport> run(Simulation& simulation, const RunOptions& options);
+
+// JSON text of the report (keys documented in scenes/README.md).
+std::string reportJson(const RunReport& report);
+std::string hashHex(std::uint64_t hash);
+
+}  // namespace hysim::engine

@@ -1,0 +1,65 @@
+#pragma once
+// Scenes: YAML files instructors write (schema: scenes/README.md). Loading checks every key
+// and value; errors name the file, the line and the key.
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "hysim/cutting/result.hpp"
+#include "hysim/haptics/trajectory.hpp"
+#include "hysim/sim/model.hpp"
+
+namespace hysim::engine {
+
+// A region whose mesh nodes are anchored (held fixed): the tissue around the modelled part.
+struct AnchorRegion {
+  enum class Kind { Box, Sphere, OutsideEllipsoid };
+  Kind kind = Kind::Box;
+  Eigen::Vector3d a{0, 0, 0};  // box: min corner; sphere/ellipsoid: centre
+  Eigen::Vector3d b{0, 0, 0};  // box: max corner; ellipsoid: semi-axes; sphere: (radius, -, -)
+  bool contains(const Eigen::Vector3d& p) const;
+};
+
+struct ContactSettings {
+  bool enabled = true;
+  double stiffness_n_per_mm = 0.02;  // penalty stiffness per surface node
+  double damping_n_s_per_mm = 0.0;   // penalty damping per surface node (normal velocity)
+  double shaft_radius_mm = 4.0;      // resectoscope sheath (26 Fr)
+  double shaft_length_mm = 60.0;     // modelled length behind the tip
+  double loop_radius_mm = 3.5;       // electrode loop, as a sphere for contact until cutting arrives
+  double loop_reach_mm = 12.0;       // loop centre ahead of the tip at extension 0
+  double loop_drop_mm = 3.0;         // loop centre below the axis (towards -up)
+};
+
+struct CameraSettings {
+  double lens_deg = 30.0;  // fore-oblique lens angle: 0, 12 or 30 in practice
+  double fov_deg = 90.0;
+  double light = 1.0;
+};
+
+struct RenderSettings {
+  int width = 640;
+  int height = 480;
+  int every = 50;  // render a frame every k steps
+};
+
+struct Scene {
+  std::string path;        // the scene file
+  std::string name;
+  std::string description;
+  std::string mesh_path;   // resolved against the scene file's folder
+  std::string tool_mesh_path;  // optional; empty = no tool surface drawn
+  std::vector<sim::Material> materials;
+  std::vector<AnchorRegion> anchors;
+  sim::ModelOptions sim;
+  int steps = 1000;
+  std::vector<haptics::Keyframe> tool_path;
+  ContactSettings contact;
+  CameraSettings camera;
+  RenderSettings render;
+};
+
+// Parses and checks a scene file. Does not load the meshes (see Simulation::create).
+Result<Scene> loadScene(const std::string& path);
+
+}  // namespace hysim::engine

@@ -1,0 +1,67 @@
+#pragma once
+// The fixed-step loop's state: tissue model, tool, contact. One call of step() advances the
+// whole simulation by the scene's dt; it never reads the wall clock and never allocates.
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "hysim/cutting/mesh.hpp"
+#include "hysim/engine/scene.hpp"
+#include "hysim/haptics/trajectory.hpp"
+#include "hysim/render/snapshot.hpp"
+#include "hysim/sim/model.hpp"
+
+namespace hysim::engine {
+
+class Simulation {
+ public:
+  // Loads the meshes named by the scene, anchors nodes, builds the tissue model.
+  static Result<std::unique_ptr<Simulation>> create(const Scene& scene);
+
+  void step();
+
+  // Fills a snapshot for the renderer. Reuses the snapshot's buffers (no allocation after
+  // the first call with the same topology).
+  void fillSnapshot(render::RenderSnapshot& snapshot) const;
+
+  const Scene& scene() const { return scene_; }
+  const cutting::TetMesh& mesh() const { return mesh_; }
+  const sim::Model& model() const { return model_; }
+  const sim::State& state() const { return state_; }
+  const haptics::ToolPose& toolPose() const { return pose_; }
+  int numAnchored() const { return num_anchored_; }
+  int numSurfaceNodes() const { return static_cast<int>(surface_nodes_.size()); }
+  // Reaction force on the tool from tissue contact in the last step, newtons.
+  const Eigen::Vector3d& toolForceN() const { return tool_force_n_; }
+  std::uint64_t stateHash() const { return sim::stateHash(state_); }
+  // Puts back a state saved from this simulation (benchmarks restore one before each batch).
+  // Same topology only; copies into the existing buffers.
+  void restoreState(const sim::State& saved) { state_ = saved; }
+
+ private:
+  Simulation() = default;
+  void computeContact();
+
+  Scene scene_;
+  cutting::TetMesh mesh_;
+  sim::Model model_;
+  sim::State state_;
+  haptics::Trajectory path_;
+  haptics::ToolPose pose_;
+
+  cutting::Tris surface_faces_;                   // #B x 3 boundary faces, model node ids
+  std::vector<int> surface_nodes_;                // #V model node ids on the boundary
+  std::vector<std::uint32_t> surface_triangles_;  // #B*3 indices into surface_nodes_
+  std::vector<render::SurfaceMaterial> surface_material_;  // #V
+  std::vector<int> contact_nodes_;                // free surface nodes (contact candidates)
+  sim::NodeVectors contact_force_;                // #N x 3, uN
+  Eigen::Vector3d tool_force_n_{0, 0, 0};
+  render::SurfaceMesh tool_surface_;              // body frame
+  int num_anchored_ = 0;
+};
+
+// Loads a surface (OBJ, STL, PLY, glTF...) with assimp, triangulated, in millimetres.
+Result<render::SurfaceMesh> loadSurface(const std::string& path, render::SurfaceMaterial material);
+
+}  // namespace hysim::engine

@@ -1,0 +1,99 @@
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <nlohmann/json.hpp>
+#include <vector>
+
+#include "hysim/engine/run.hpp"
+
+namespace hysim::engine {
+namespace {
+
+double percentile(std::vector<double> values, double p) {
+  if (values.empty()) return 0.0;
+  const size_t k = std::min(values.size() - 1, static_cast<size_t>(p * static_cast<double>(values.size() - 1) + 0.5));
+  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(k), values.end());
+  return values[k];
+}
+
+}  // namespace
+
+std::string hashHex(std::uint64_t hash) {
+  char buf[17];
+  std::snprintf(buf, sizeof(buf), "%016llx", static_cast<unsigned long long>(hash));
+  return buf;
+}
+
+Result<RunReport> run(Simulation& sim, const RunOptions& options) {
+  using Clock = std::chrono::steady_clock;
+  const Scene& scene = sim.scene();
+  RunReport r;
+  r.scene = scene.name;
+  r.steps = options.steps >= 0 ? options.steps : scene.steps;
+  const int every = options.every > 0 ? options.every : scene.render.every;
+  r.dt = scene.sim.dt;
+  r.nodes = sim.mesh().numNodes();
+  r.elements = sim.mesh().numTets();
+  r.springs = static_cast<int>(sim.model().springs.rows());
+  r.anchored = sim.numAnchored();
+  r.substeps = sim.model().substeps;
+  r.critical_dt = sim.model().critical_dt;
+  r.integrator = scene.sim.integrator == sim::Integrator::ImplicitEuler ? "implicit_euler" : "symplectic_euler";
+
+  std::vector<double> step_us;
+  step_us.reserve(static_cast<size_t>(r.steps));
+  std::vector<double> frame_ms;
+  render::RenderSnapshot snapshot;
+  const auto wall0 = Clock::now();
+  auto frame = [&]() -> Status {
+    if (!options.on_frame) return Status::Ok();
+    const auto t0 = Clock::now();
+    sim.fillSnapshot(snapshot);
+    Status st = options.on_frame(snapshot, r.frames);
+    frame_ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
+    ++r.frames;
+    return st;
+  };
+  if (Status st = frame(); !st.ok()) return Error{st.error()};
+  for (int i = 0; i < r.steps; ++i) {
+    const auto t0 = Clock::now();
+    sim.step();
+    step_us.push_back(std::chrono::duration<double, std::micro>(Clock::now() - t0).count());
+    r.max_tool_force_n = std::max(r.max_tool_force_n, sim.toolForceN().norm());
+    if ((i + 1) % every == 0) {
+      if (Status st = frame(); !st.ok()) return Error{st.error()};
+    }
+  }
+  r.wall_s = std::chrono::duration<double>(Clock::now() - wall0).count();
+  r.step_us_median = percentile(step_us, 0.5);
+  r.step_us_p99 = percentile(step_us, 0.99);
+  r.step_us_max = step_us.empty() ? 0.0 : *std::max_element(step_us.begin(), step_us.end());
+  r.frame_ms_median = percentile(frame_ms, 0.5);
+  r.state_hash = sim.stateHash();
+  r.warnings = sim.state().warnings;
+  return r;
+}
+
+std::string reportJson(const RunReport& r) {
+  nlohmann::ordered_json j;
+  j["scene"] = r.scene;
+  j["integrator"] = r.integrator;
+  j["steps"] = r.steps;
+  j["dt"] = r.dt;
+  j["nodes"] = r.nodes;
+  j["elements"] = r.elements;
+  j["springs"] = r.springs;
+  j["anchored_nodes"] = r.anchored;
+  j["substeps"] = r.substeps;
+  j["critical_dt"] = r.critical_dt;
+  j["step_us"] = {{"median", r.step_us_median}, {"p99", r.step_us_p99}, {"max", r.step_us_max}};
+  j["frames"] = r.frames;
+  j["frame_ms"] = {{"median", r.frame_ms_median}};
+  j["state_hash"] = hashHex(r.state_hash);
+  j["warnings"] = r.warnings;
+  j["max_tool_force_n"] = r.max_tool_force_n;
+  j["wall_s"] = r.wall_s;
+  return j.dump(2) + "\n";
+}
+
+}  // namespace hysim::engine

@@ -1,0 +1,292 @@
+#include "hysim/engine/scene.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+namespace hysim::engine {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Thrown inside the parser only and turned into a Result at the boundary: the parser is a
+// deep recursive walk and an early exit from every level would hide its logic.
+struct SceneError {
+  std::string message;
+};
+
+class Reader {
+ public:
+  explicit Reader(std::string file) : file_(std::move(file)) {}
+
+  [[noreturn]] void fail(const YAML::Node& at, const std::string& what) const {
+    std::ostringstream out;
+    out << file_;
+    if (at.IsDefined() && at.Mark().line >= 0) out << ":" << at.Mark().line + 1;
+    out << ": " << what;
+    throw SceneError{out.str()};
+  }
+
+  // Every key of `map` must be in `allowed`.
+  void checkKeys(const YAML::Node& map, const std::string& where, const std::set<std::string>& allowed) const {
+    if (!map.IsMap()) fail(map, "'" + where + "' must be a mapping");
+    for (const auto& kv : map) {
+      const std::string key = kv.first.as<std::string>();
+      if (!allowed.count(key)) {
+        std::string list;
+        for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
+        fail(kv.first, "unknown key '" + key + "' in '" + where + "' (allowed: " + list + ")");
+      }
+    }
+  }
+
+  YAML::Node require(const YAML::Node& map, const std::string& key, const std::string& where) const {
+    YAML::Node n = map[key];
+    if (!n.IsDefined() || n.IsNull()) fail(map, "missing required key '" + key + "' in '" + where + "'");
+    return n;
+  }
+
+  double number(const YAML::Node& n, const std::string& key) const {
+    if (!n.IsScalar()) fail(n, "'" + key + "' must be a number");
+    double value = 0.0;
+    if (!YAML::convert<double>::decode(n, value)) fail(n, "'" + key + "' must be a number, got '" + n.Scalar() + "'");
+    if (!std::isfinite(value)) fail(n, "'" + key + "' must be finite, got '" + n.Scalar() + "'");
+    return value;
+  }
+  double positive(const YAML::Node& n, const std::string& key) const {
+    const double v = number(n, key);
+    if (!(v > 0.0)) fail(n, "'" + key + "' must be positive, got " + n.Scalar());
+    return v;
+  }
+  double nonNegative(const YAML::Node& n, const std::string& key) const {
+    const double v = number(n, key);
+    if (v < 0.0) fail(n, "'" + key + "' must not be negative, got " + n.Scalar());
+    return v;
+  }
+  int integer(const YAML::Node& n, const std::string& key, int lo, int hi) const {
+    if (!n.IsScalar()) fail(n, "'" + key + "' must be an integer");
+    long long value = 0;
+    if (!YAML::convert<long long>::decode(n, value)) fail(n, "'" + key + "' must be an integer, got '" + n.Scalar() + "'");
+    if (value < lo || value > hi) {
+      fail(n, "'" + key + "' must be between " + std::to_string(lo) + " and " + std::to_string(hi) + ", got " + n.Scalar());
+    }
+    return static_cast<int>(value);
+  }
+  bool boolean(const YAML::Node& n, const std::string& key) const {
+    bool value = false;
+    if (!n.IsScalar() || !YAML::convert<bool>::decode(n, value)) fail(n, "'" + key + "' must be true or false");
+    return value;
+  }
+  std::string string(const YAML::Node& n, const std::string& key) const {
+    if (!n.IsScalar()) fail(n, "'" + key + "' must be a string");
+    return n.Scalar();
+  }
+  Eigen::Vector3d vec3(const YAML::Node& n, const std::string& key) const {
+    if (!n.IsSequence() || n.size() != 3) fail(n, "'" + key + "' must be a list of 3 numbers [x, y, z]");
+    return {number(n[0], key), number(n[1], key), number(n[2], key)};
+  }
+  Eigen::Vector3d unitVec3(const YAML::Node& n, const std::string& key) const {
+    const Eigen::Vector3d v = vec3(n, key);
+    if (v.norm() < 1e-9) fail(n, "'" + key + "' must be a non-zero direction");
+    return v.normalized();
+  }
+
+ private:
+  std::string file_;
+};
+
+sim::Material parseMaterial(const Reader& r, const YAML::Node& n) {
+  r.checkKeys(n, "materials[]", {"name", "label", "young_modulus_kpa", "density_g_cm3", "damping_s"});
+  sim::Material m;
+  m.name = r.string(r.require(n, "name", "materials[]"), "name");
+  m.label = r.integer(r.require(n, "label", "materials[]"), "label", 0, 1 << 30);
+  m.young_modulus_pa = 1e3 * r.positive(r.require(n, "young_modulus_kpa", "materials[]"), "young_modulus_kpa");
+  m.density_g_mm3 = 1e-3 * r.positive(r.require(n, "density_g_cm3", "materials[]"), "density_g_cm3");
+  if (n["damping_s"]) m.stiffness_damping_s = r.nonNegative(n["damping_s"], "damping_s");
+  return m;
+}
+
+AnchorRegion parseAnchor(const Reader& r, const YAML::Node& n) {
+  r.checkKeys(n, "anchors[]", {"box", "sphere", "outside_ellipsoid"});
+  if (n.size() != 1) r.fail(n, "each anchor must have exactly one of: box, sphere, outside_ellipsoid");
+  AnchorRegion a;
+  if (n["box"]) {
+    const YAML::Node b = n["box"];
+    r.checkKeys(b, "box", {"min", "max"});
+    a.kind = AnchorRegion::Kind::Box;
+    a.a = r.vec3(r.require(b, "min", "box"), "min");
+    a.b = r.vec3(r.require(b, "max", "box"), "max");
+    if ((a.b.array() < a.a.array()).any()) r.fail(b, "'box' needs min <= max in every coordinate");
+  } else if (n["sphere"]) {
+    const YAML::Node s = n["sphere"];
+    r.checkKeys(s, "sphere", {"center", "radius"});
+    a.kind = AnchorRegion::Kind::Sphere;
+    a.a = r.vec3(r.require(s, "center", "sphere"), "center");
+    a.b = Eigen::Vector3d(r.positive(r.require(s, "radius", "sphere"), "radius"), 0, 0);
+  } else {
+    const YAML::Node e = n["outside_ellipsoid"];
+    r.checkKeys(e, "outside_ellipsoid", {"center", "radii"});
+    a.kind = AnchorRegion::Kind::OutsideEllipsoid;
+    a.a = r.vec3(r.require(e, "center", "outside_ellipsoid"), "center");
+    a.b = r.vec3(r.require(e, "radii", "outside_ellipsoid"), "radii");
+    if ((a.b.array() <= 0.0).any()) r.fail(e, "'radii' must be positive");
+  }
+  return a;
+}
+
+void parseSimulation(const Reader& r, const YAML::Node& n, Scene& scene) {
+  r.checkKeys(n, "simulation", {"dt_ms", "steps", "integrator", "substeps", "implicit_iterations", "drag_per_s",
+                                "gravity_mm_s2", "max_speed_mm_s"});
+  if (n["dt_ms"]) {
+    const double dt_ms = r.positive(n["dt_ms"], "dt_ms");
+    if (dt_ms > 100.0) r.fail(n["dt_ms"], "'dt_ms' must be at most 100, got " + n["dt_ms"].Scalar());
+    scene.sim.dt = 1e-3 * dt_ms;
+  }
+  if (n["steps"]) scene.steps = r.integer(n["steps"], "steps", 0, 100000000);
+  if (n["integrator"]) {
+    const std::string s = r.string(n["integrator"], "integrator");
+    if (s == "symplectic_euler") scene.sim.integrator = sim::Integrator::SymplecticEuler;
+    else if (s == "implicit_euler") scene.sim.integrator = sim::Integrator::ImplicitEuler;
+    else r.fail(n["integrator"], "'integrator' must be symplectic_euler or implicit_euler, got '" + s + "'");
+  }
+  if (n["substeps"]) {
+    if (n["substeps"].IsScalar() && n["substeps"].Scalar() == "auto") scene.sim.substeps = 0;
+    else scene.sim.substeps = r.integer(n["substeps"], "substeps", 1, 10000);
+  }
+  if (n["implicit_iterations"]) scene.sim.implicit_iterations = r.integer(n["implicit_iterations"], "implicit_iterations", 1, 1000);
+  if (n["drag_per_s"]) scene.sim.drag_per_s = r.nonNegative(n["drag_per_s"], "drag_per_s");
+  if (n["gravity_mm_s2"]) scene.sim.gravity = r.vec3(n["gravity_mm_s2"], "gravity_mm_s2");
+  if (n["max_speed_mm_s"]) scene.sim.max_speed_mm_s = r.positive(n["max_speed_mm_s"], "max_speed_mm_s");
+}
+
+void parseContact(const Reader& r, const YAML::Node& n, ContactSettings& c) {
+  r.checkKeys(n, "contact", {"enabled", "stiffness_n_per_mm", "damping_n_s_per_mm", "shaft_radius_mm",
+                             "shaft_length_mm", "loop_radius_mm", "loop_reach_mm", "loop_drop_mm"});
+  if (n["enabled"]) c.enabled = r.boolean(n["enabled"], "enabled");
+  if (n["stiffness_n_per_mm"]) c.stiffness_n_per_mm = r.nonNegative(n["stiffness_n_per_mm"], "stiffness_n_per_mm");
+  if (n["damping_n_s_per_mm"]) c.damping_n_s_per_mm = r.nonNegative(n["damping_n_s_per_mm"], "damping_n_s_per_mm");
+  if (n["shaft_radius_mm"]) c.shaft_radius_mm = r.positive(n["shaft_radius_mm"], "shaft_radius_mm");
+  if (n["shaft_length_mm"]) c.shaft_length_mm = r.positive(n["shaft_length_mm"], "shaft_length_mm");
+  if (n["loop_radius_mm"]) c.loop_radius_mm = r.positive(n["loop_radius_mm"], "loop_radius_mm");
+  if (n["loop_reach_mm"]) c.loop_reach_mm = r.number(n["loop_reach_mm"], "loop_reach_mm");
+  if (n["loop_drop_mm"]) c.loop_drop_mm = r.number(n["loop_drop_mm"], "loop_drop_mm");
+}
+
+haptics::Keyframe parseKeyframe(const Reader& r, const YAML::Node& n, double previous_time) {
+  r.checkKeys(n, "tool_path[]", {"t_s", "tip", "axis", "up", "extension_mm", "pedal"});
+  haptics::Keyframe k;
+  k.time_s = r.nonNegative(r.require(n, "t_s", "tool_path[]"), "t_s");
+  if (k.time_s < previous_time) {
+    r.fail(n["t_s"], "'t_s' must not decrease along tool_path (" + n["t_s"].Scalar() + " after " +
+                         std::to_string(previous_time) + ")");
+  }
+  k.tip = r.vec3(r.require(n, "tip", "tool_path[]"), "tip");
+  k.axis = r.unitVec3(r.require(n, "axis", "tool_path[]"), "axis");
+  if (n["up"]) k.up = r.unitVec3(n["up"], "up");
+  if (std::abs(k.up.dot(k.axis)) > 0.999) r.fail(n["up"] ? n["up"] : n, "'up' must not be parallel to 'axis'");
+  if (n["extension_mm"]) k.extension_mm = r.number(n["extension_mm"], "extension_mm");
+  if (n["pedal"]) k.pedal = r.boolean(n["pedal"], "pedal");
+  return k;
+}
+
+Scene parse(const Reader& r, const YAML::Node& root, const std::string& path) {
+  Scene scene;
+  scene.path = path;
+  if (!root.IsDefined() || root.IsNull()) r.fail(root, "the scene file is empty");
+  r.checkKeys(root, "scene", {"name", "description", "mesh", "tool_mesh", "materials", "anchors", "simulation",
+                              "contact", "tool_path", "camera", "render"});
+  const fs::path dir = fs::path(path).parent_path();
+  auto resolve = [&](const YAML::Node& n, const std::string& key) {
+    const std::string rel = r.string(n, key);
+    const fs::path p = fs::path(rel).is_absolute() ? fs::path(rel) : dir / rel;
+    std::error_code ec;
+    if (!fs::is_regular_file(p, ec)) r.fail(n, "'" + key + "' file '" + p.string() + "' does not exist");
+    return p.lexically_normal().string();
+  };
+  scene.name = r.string(r.require(root, "name", "scene"), "name");
+  if (root["description"]) scene.description = r.string(root["description"], "description");
+  scene.mesh_path = resolve(r.require(root, "mesh", "scene"), "mesh");
+  if (root["tool_mesh"]) scene.tool_mesh_path = resolve(root["tool_mesh"], "tool_mesh");
+
+  const YAML::Node mats = r.require(root, "materials", "scene");
+  if (!mats.IsSequence() || mats.size() == 0) r.fail(mats, "'materials' must be a non-empty list");
+  std::set<int> labels;
+  for (const auto& m : mats) {
+    scene.materials.push_back(parseMaterial(r, m));
+    if (!labels.insert(scene.materials.back().label).second) {
+      r.fail(m, "material label " + std::to_string(scene.materials.back().label) + " is used twice");
+    }
+  }
+  if (root["anchors"]) {
+    const YAML::Node an = root["anchors"];
+    if (!an.IsSequence()) r.fail(an, "'anchors' must be a list");
+    for (const auto& a : an) scene.anchors.push_back(parseAnchor(r, a));
+  }
+  if (root["simulation"]) parseSimulation(r, root["simulation"], scene);
+  if (root["contact"]) parseContact(r, root["contact"], scene.contact);
+
+  const YAML::Node tp = r.require(root, "tool_path", "scene");
+  if (!tp.IsSequence() || tp.size() == 0) r.fail(tp, "'tool_path' must be a non-empty list of keyframes");
+  double previous = 0.0;
+  for (const auto& k : tp) {
+    scene.tool_path.push_back(parseKeyframe(r, k, previous));
+    previous = scene.tool_path.back().time_s;
+  }
+  if (root["camera"]) {
+    const YAML::Node c = root["camera"];
+    r.checkKeys(c, "camera", {"lens_deg", "fov_deg", "light"});
+    if (c["lens_deg"]) {
+      scene.camera.lens_deg = r.number(c["lens_deg"], "lens_deg");
+      if (scene.camera.lens_deg < 0.0 || scene.camera.lens_deg > 70.0) r.fail(c["lens_deg"], "'lens_deg' must be between 0 and 70");
+    }
+    if (c["fov_deg"]) {
+      scene.camera.fov_deg = r.number(c["fov_deg"], "fov_deg");
+      if (scene.camera.fov_deg < 10.0 || scene.camera.fov_deg > 170.0) r.fail(c["fov_deg"], "'fov_deg' must be between 10 and 170");
+    }
+    if (c["light"]) scene.camera.light = r.positive(c["light"], "light");
+  }
+  if (root["render"]) {
+    const YAML::Node rn = root["render"];
+    r.checkKeys(rn, "render", {"width", "height", "every"});
+    if (rn["width"]) scene.render.width = r.integer(rn["width"], "width", 16, 8192);
+    if (rn["height"]) scene.render.height = r.integer(rn["height"], "height", 16, 8192);
+    if (rn["every"]) scene.render.every = r.integer(rn["every"], "every", 1, 1000000);
+  }
+  return scene;
+}
+
+}  // namespace
+
+bool AnchorRegion::contains(const Eigen::Vector3d& p) const {
+  switch (kind) {
+    case Kind::Box:
+      return (p.array() >= a.array()).all() && (p.array() <= b.array()).all();
+    case Kind::Sphere:
+      return (p - a).norm() <= b.x();
+    case Kind::OutsideEllipsoid:
+      return ((p - a).array() / b.array()).matrix().squaredNorm() >= 1.0;
+  }
+  return false;
+}
+
+Result<Scene> loadScene(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) return Error{path + ": cannot open scene file"};
+  const Reader reader(path);
+  try {
+    const YAML::Node root = YAML::Load(in);
+    return parse(reader, root, path);
+  } catch (const SceneError& e) {
+    return Error{e.message};
+  } catch (const YAML::Exception& e) {
+    // yaml-cpp marks are 0-based.
+    return Error{path + ":" + std::to_string(e.mark.line + 1) + ":" + std::to_string(e.mark.column + 1) +
+                 ": YAML error: " + e.msg};
+  }
+}
+
+}  // namespace hysim::engine

@@ -1,0 +1,116 @@
+#pragma once
+// Mass-spring tissue model. A scene compiles to a Model (what does not change while
+// stepping); everything that changes lives in State (MuJoCo's mjModel / mjData split).
+//
+// Units (consistent, so no conversion factors appear in the step):
+//   length mm, mass g, time s  =>  force g*mm/s^2 = 1 uN, stiffness g/s^2 (= mN/m),
+//   pressure / Young's modulus g/(mm*s^2) = 1 Pa, density g/mm^3 (1 g/cm^3 = 1e-3 g/mm^3).
+#include <Eigen/Core>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "hysim/cutting/mesh.hpp"
+
+namespace hysim::sim {
+
+struct Material {
+  std::string name;
+  int label = 0;                      // element label in the mesh (Gmsh physical tag)
+  double young_modulus_pa = 60e3;     // E; myometrium ~30-90 kPa, fibroids ~60-220 kPa
+  double density_g_mm3 = 1.05e-3;     // rho; soft tissue ~1.05 g/cm^3
+  double stiffness_damping_s = 0.0;   // beta: spring damping c = beta * k (Rayleigh, stiffness part)
+};
+
+enum class Integrator {
+  SymplecticEuler,  // semi-implicit Euler, explicit springs, `substeps` per step
+  ImplicitEuler,    // backward Euler, local/global iterations on a prefactored sparse matrix
+};
+
+struct ModelOptions {
+  double dt = 1e-3;                            // s, fixed step
+  Integrator integrator = Integrator::SymplecticEuler;
+  int substeps = 0;                            // symplectic Euler; 0 = choose from the stability limit
+  double stability_safety = 0.85;               // substep = safety * critical step when automatic
+  int implicit_iterations = 8;                 // local/global iterations per implicit step
+  double drag_per_s = 0.0;                     // alpha: mass-proportional damping (fluid drag), 1/s
+  Eigen::Vector3d gravity{0.0, 0.0, -9810.0};  // mm/s^2
+  double max_speed_mm_s = 1e5;                 // a node faster than this is numerical trouble
+};
+
+class ImplicitSolver;  // prefactored system of the implicit integrator (step.cpp)
+
+// Per-node vectors (#N x 3). Row-major: a node's x, y, z are adjacent, so a spring touches
+// two cache lines per array instead of six (the step is bound by these gathers).
+using NodeVectors = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
+
+// One spring's data packed together for the step's inner loop (derived from the arrays
+// below by buildModel; the arrays stay the reference).
+struct PackedSpring {
+  std::int32_t a, b;
+  double rest_length, stiffness, damping;
+};
+
+struct Model {
+  using SpringIndex = Eigen::Matrix<std::int32_t, Eigen::Dynamic, 2>;
+
+  int num_nodes = 0;
+  Eigen::VectorXd mass;            // #N, g (lumped: a quarter of each incident tet's mass)
+  Eigen::VectorXd inv_mass;        // #N, 1/g; 0 for fixed nodes
+  SpringIndex springs;             // #S x 2 node indices, one spring per unique tet edge
+  Eigen::VectorXd rest_length;     // #S, mm
+  Eigen::VectorXd stiffness;       // #S, g/s^2: Van Gelder k = sum_t E_t V_t / |e|^2
+  Eigen::VectorXd damping;         // #S, g/s: c = beta * k
+  std::vector<std::uint8_t> fixed; // #N, 1 = anchored (never moves)
+  std::vector<PackedSpring> packed; // #S, same springs as above, for the step
+  std::vector<Material> materials;
+
+  ModelOptions options;
+  double substep = 0.0;            // s, symplectic Euler substep (dt / substeps)
+  int substeps = 1;
+  double critical_dt = 0.0;        // s, estimated stability limit of symplectic Euler
+  double omega_max = 0.0;          // rad/s, estimated highest natural frequency
+
+  std::shared_ptr<const ImplicitSolver> implicit;  // set when integrator == ImplicitEuler
+};
+
+struct State {
+  NodeVectors x;        // #N x 3 positions, mm
+  NodeVectors v;        // #N x 3 velocities, mm/s
+  NodeVectors f;        // #N x 3 force accumulator, uN
+  NodeVectors scratch0; // #N x 3 integrator scratch (sized when the model is built)
+  NodeVectors scratch1; // #N x 3
+  NodeVectors scratch2; // #N x 3
+  Eigen::MatrixX3d solve0;  // #N x 3 column-major: the sparse triangular solves work in place
+  Eigen::MatrixX3d solve1;  // on column-major right-hand sides without temporaries
+  std::uint64_t steps = 0;
+  double time = 0.0;         // s, steps * dt (never read from a clock)
+  int warnings = 0;          // numerical trouble events (divergence); the step never throws
+  bool diverged = false;     // once set, the step leaves the state untouched
+};
+
+struct StepInput {
+  const NodeVectors* external_force = nullptr;  // #N x 3 uN (contact), or null
+};
+
+// Builds the model. `fixed_nodes` are anchored at their rest positions. Materials are looked
+// up by the mesh's element labels; an element label with no material is an error.
+Result<Model> buildModel(const cutting::TetMesh& mesh, const std::vector<Material>& materials,
+                         const std::vector<int>& fixed_nodes, const ModelOptions& options);
+
+// Rest state: x = mesh positions, v = 0, scratch sized.
+State makeState(const Model& model, const cutting::TetMesh& mesh);
+
+// Advances the state by one fixed step dt. Allocates nothing; never throws. Non-finite
+// values or speeds above options.max_speed_mm_s count a warning and freeze the state.
+void step(const Model& model, State& state, const StepInput& input);
+
+// Energies (for tests and reports), g*mm^2/s^2 = nJ.
+double kineticEnergy(const Model& model, const State& state);
+double springEnergy(const Model& model, const State& state);
+
+// 64-bit FNV-1a hash over the bytes of x and v: equal states hash equal; bitwise.
+std::uint64_t stateHash(const State& state);
+
+}  // namespace hysim::sim

@@ -1,0 +1,166 @@
+// Scene files: the default scene loads; every kind of bad input gives a one-line message
+// naming the file and the line (or the value), never a crash.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "hysim/engine/scene.hpp"
+#include "hysim/engine/simulation.hpp"
+
+namespace hysim::engine {
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::string kAssets = std::string(HYSIM_SOURCE_DIR) + "/assets";
+
+std::string writeFile(const std::string& name, const std::string& text) {
+  const fs::path dir = fs::path(HYSIM_TEST_OUTPUT_DIR) / "scenes";
+  fs::create_directories(dir);
+  const fs::path p = dir / name;
+  std::ofstream(p) << text;
+  return p.string();
+}
+
+// A valid minimal scene; tests replace one line to break it.
+std::string minimalScene(const std::string& mesh = kAssets + "/uterus_myoma.msh") {
+  return "name: test\n"                                             // line 1
+         "mesh: " + mesh + "\n"                                     // line 2
+         "materials:\n"                                             // line 3
+         "  - {name: myometrium, label: 1, young_modulus_kpa: 60, density_g_cm3: 1.05}\n"  // 4
+         "  - {name: myoma, label: 2, young_modulus_kpa: 150, density_g_cm3: 1.1}\n"       // 5
+         "simulation:\n"                                            // line 6
+         "  dt_ms: 1.0\n"                                           // line 7
+         "  steps: 10\n"                                            // line 8
+         "tool_path:\n"                                             // line 9
+         "  - {t_s: 0, tip: [0, 2, -24], axis: [0, 0, 1]}\n";       // line 10
+}
+
+std::string replaceLine(std::string text, int line, const std::string& replacement) {
+  size_t start = 0;
+  for (int i = 1; i < line; ++i) start = text.find('\n', start) + 1;
+  const size_t end = text.find('\n', start);
+  return text.replace(start, end - start, replacement);
+}
+
+void expectError(const std::string& file_name, const std::string& text, const std::string& where,
+                 const std::string& what) {
+  const std::string path = writeFile(file_name, text);
+  auto scene = loadScene(path);
+  ASSERT_FALSE(scene.ok()) << file_name << " should fail";
+  const std::string& msg = scene.error();
+  EXPECT_NE(msg.find(path + where), std::string::npos) << msg;
+  EXPECT_NE(msg.find(what), std::string::npos) << msg;
+  EXPECT_EQ(msg.find('\n'), std::string::npos) << "one line: " << msg;
+}
+
+TEST(Scene, DefaultSceneLoads) {
+  auto scene = loadScene(std::string(HYSIM_SOURCE_DIR) + "/scenes/default.yaml");
+  ASSERT_TRUE(scene.ok()) << scene.error();
+  EXPECT_EQ(scene->name, "default");
+  EXPECT_EQ(scene->materials.size(), 2u);
+  EXPECT_DOUBLE_EQ(scene->sim.dt, 1e-3);
+  EXPECT_GE(scene->tool_path.size(), 2u);
+  EXPECT_TRUE(fs::exists(scene->mesh_path));
+}
+
+TEST(Scene, MinimalSceneLoadsWithDefaults) {
+  auto scene = loadScene(writeFile("minimal.yaml", minimalScene()));
+  ASSERT_TRUE(scene.ok()) << scene.error();
+  EXPECT_EQ(scene->steps, 10);
+  EXPECT_EQ(scene->render.width, 640);
+  EXPECT_NEAR(scene->materials[1].young_modulus_pa, 150e3, 1e-9);
+  EXPECT_NEAR(scene->materials[1].density_g_mm3, 1.1e-3, 1e-15);
+}
+
+TEST(SceneErrors, BadYaml) {
+  expectError("bad_yaml.yaml", replaceLine(minimalScene(), 7, "  dt_ms: [1.0"), ":", "YAML error");
+}
+
+TEST(SceneErrors, UnknownKey) {
+  expectError("unknown_key.yaml", replaceLine(minimalScene(), 7, "  dt_msec: 1.0"), ":7:",
+              "unknown key 'dt_msec' in 'simulation'");
+}
+
+TEST(SceneErrors, UnknownTopLevelKey) {
+  expectError("unknown_top.yaml", minimalScene() + "colour: red\n", ":11:", "unknown key 'colour'");
+}
+
+TEST(SceneErrors, WrongType) {
+  expectError("wrong_type.yaml", replaceLine(minimalScene(), 8, "  steps: many"), ":8:",
+              "'steps' must be an integer, got 'many'");
+}
+
+TEST(SceneErrors, WrongVectorShape) {
+  expectError("wrong_vec.yaml", replaceLine(minimalScene(), 10, "  - {t_s: 0, tip: [0, 2], axis: [0, 0, 1]}"), ":10:",
+              "'tip' must be a list of 3 numbers");
+}
+
+TEST(SceneErrors, NanValue) {
+  expectError("nan_value.yaml", replaceLine(minimalScene(), 7, "  dt_ms: .nan"), ":7:", "'dt_ms' must be finite");
+}
+
+TEST(SceneErrors, NegativeValue) {
+  expectError("negative.yaml",
+              replaceLine(minimalScene(), 4, "  - {name: myometrium, label: 1, young_modulus_kpa: -60, density_g_cm3: 1.05}"),
+              ":4:", "'young_modulus_kpa' must be positive");
+}
+
+TEST(SceneErrors, MissingRequiredKey) {
+  expectError("missing_key.yaml", replaceLine(minimalScene(), 1, "# no name"), ":", "missing required key 'name'");
+}
+
+TEST(SceneErrors, MissingMeshFile) {
+  expectError("missing_mesh.yaml", minimalScene("/nonexistent/uterus.msh"), ":2:",
+              "'mesh' file '/nonexistent/uterus.msh' does not exist");
+}
+
+TEST(SceneErrors, UnknownIntegrator) {
+  expectError("integrator.yaml", replaceLine(minimalScene(), 8, "  integrator: rk4"), ":8:",
+              "'integrator' must be symplectic_euler or implicit_euler, got 'rk4'");
+}
+
+TEST(SceneErrors, TimeGoesBackwards) {
+  expectError("backwards.yaml", minimalScene() + "  - {t_s: -1, tip: [0, 0, 0], axis: [0, 0, 1]}\n", ":11:",
+              "'t_s' must not be negative");
+}
+
+TEST(SceneErrors, EmptyFileAndMissingFile) {
+  expectError("empty.yaml", "", ":", "empty");
+  auto scene = loadScene("/nonexistent/scene.yaml");
+  ASSERT_FALSE(scene.ok());
+  EXPECT_NE(scene.error().find("/nonexistent/scene.yaml: cannot open"), std::string::npos) << scene.error();
+}
+
+TEST(SceneErrors, NanInMeshNamesMeshFileAndLine) {
+  // Copy the asset with one coordinate replaced by nan; the scene loads, the mesh does not.
+  std::ifstream in(kAssets + "/uterus_myoma.msh");
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const size_t nodes = text.find("$Nodes\n");
+  ASSERT_NE(nodes, std::string::npos);
+  const size_t line3 = text.find('\n', text.find('\n', nodes + 7) + 1) + 1;  // 2nd node line
+  const size_t x_start = text.find(' ', line3) + 1;
+  const size_t x_end = text.find(' ', x_start);
+  text.replace(x_start, x_end - x_start, "nan");
+  const std::string mesh = writeFile("nan_mesh.msh", text);
+  int line = 1;
+  for (size_t i = 0; i < x_start; ++i) line += text[i] == '\n';
+  auto scene = loadScene(writeFile("nan_mesh.yaml", minimalScene(mesh)));
+  ASSERT_TRUE(scene.ok()) << scene.error();
+  auto sim = Simulation::create(*scene);
+  ASSERT_FALSE(sim.ok());
+  EXPECT_NE(sim.error().find(mesh + ":" + std::to_string(line)), std::string::npos) << sim.error();
+}
+
+TEST(SceneErrors, MaterialMissingForMeshLabel) {
+  std::string text = replaceLine(minimalScene(), 5, "");
+  auto scene = loadScene(writeFile("no_myoma.yaml", text));
+  ASSERT_TRUE(scene.ok()) << scene.error();
+  auto sim = Simulation::create(*scene);
+  ASSERT_FALSE(sim.ok());
+  EXPECT_NE(sim.error().find("material label 2"), std::string::npos) << sim.error();
+}
+
+}  // namespace
+}  // namespace hysim::engine

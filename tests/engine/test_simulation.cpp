@@ -1,0 +1,95 @@
+// The fixed-step loop on the default scene: determinism, contact, a sane run.
+#include <gtest/gtest.h>
+
+#include "hysim/engine/run.hpp"
+#include "hysim/engine/scene.hpp"
+#include "hysim/engine/simulation.hpp"
+
+namespace hysim::engine {
+namespace {
+
+Scene defaultScene() {
+  auto scene = loadScene(std::string(HYSIM_SOURCE_DIR) + "/scenes/default.yaml");
+  EXPECT_TRUE(scene.ok()) << scene.error();
+  return *scene;
+}
+
+TEST(Simulation, DefaultSceneIsBigEnoughAndStable) {
+  auto sim = Simulation::create(defaultScene());
+  ASSERT_TRUE(sim.ok()) << sim.error();
+  const auto& mesh = (*sim)->mesh();
+  int deformable = 0;  // tets with at least one free node
+  for (int t = 0; t < mesh.numTets(); ++t) {
+    bool moves = false;
+    for (int c = 0; c < 4; ++c) moves |= !(*sim)->model().fixed[mesh.T(t, c)];
+    deformable += moves;
+  }
+  EXPECT_GE(deformable, 10000);
+  EXPECT_GT((*sim)->numAnchored(), 0);
+  EXPECT_LE((*sim)->model().substep, 0.85 * (*sim)->model().critical_dt * 1.0001);
+  for (int i = 0; i < 300; ++i) (*sim)->step();
+  EXPECT_EQ((*sim)->state().warnings, 0);
+  EXPECT_TRUE((*sim)->state().x.allFinite());
+}
+
+TEST(Simulation, SameSceneTwiceGivesTheSameHash) {
+  const Scene scene = defaultScene();
+  RunOptions options;
+  options.steps = 400;
+  auto a = Simulation::create(scene);
+  auto b = Simulation::create(scene);
+  ASSERT_TRUE(a.ok() && b.ok());
+  auto ra = run(**a, options);
+  auto rb = run(**b, options);
+  ASSERT_TRUE(ra.ok() && rb.ok());
+  EXPECT_EQ(hashHex(ra->state_hash), hashHex(rb->state_hash));
+  EXPECT_NE(ra->state_hash, sim::stateHash(sim::makeState((*a)->model(), (*a)->mesh())));  // it moved
+}
+
+TEST(Simulation, LoopPushesTheMyomaAndFeelsIt) {
+  // Default path: at 2 s the extended loop presses on the myoma.
+  Scene scene = defaultScene();
+  auto with = Simulation::create(scene);
+  scene.contact.enabled = false;
+  auto without = Simulation::create(scene);
+  ASSERT_TRUE(with.ok() && without.ok());
+  double max_force = 0;
+  for (int i = 0; i < 2300; ++i) {
+    (*with)->step();
+    (*without)->step();
+    max_force = std::max(max_force, (*with)->toolForceN().norm());
+  }
+  EXPECT_GT(max_force, 0.05);  // newtons
+  EXPECT_LT(max_force, 20.0);
+  const double moved = ((*with)->state().x - (*without)->state().x).rowwise().norm().maxCoeff();
+  EXPECT_GT(moved, 0.5);  // mm
+  EXPECT_EQ((*with)->state().warnings, 0);
+}
+
+TEST(Simulation, SnapshotCarriesSurfaceCameraAndTool) {
+  auto sim = Simulation::create(defaultScene());
+  ASSERT_TRUE(sim.ok());
+  render::RenderSnapshot snap;
+  (*sim)->fillSnapshot(snap);
+  EXPECT_EQ(snap.tissue.positions.size(), 3 * snap.tissue.material.size());
+  EXPECT_EQ(snap.tissue.triangles.size() % 3, 0u);
+  EXPECT_GT(snap.tissue.triangles.size(), 3000u);
+  size_t myoma = 0;
+  for (auto m : snap.tissue.material) myoma += m == render::SurfaceMaterial::Myoma;
+  EXPECT_GT(myoma, 50u);
+  EXPECT_TRUE(snap.tool_visible);
+  EXPECT_FLOAT_EQ(snap.camera.lens_deg, 30.0f);
+  EXPECT_FLOAT_EQ(snap.camera.tip[2], -24.0f);
+}
+
+TEST(Surface, MissingOrBadToolFileIsAnError) {
+  auto missing = loadSurface("/nonexistent/tool.stl", render::SurfaceMaterial::Tool);
+  ASSERT_FALSE(missing.ok());
+  EXPECT_NE(missing.error().find("/nonexistent/tool.stl"), std::string::npos);
+  auto tool = loadSurface(std::string(HYSIM_SOURCE_DIR) + "/assets/resectoscope.stl", render::SurfaceMaterial::Tool);
+  ASSERT_TRUE(tool.ok()) << tool.error();
+  EXPECT_GT(tool->triangles.size(), 300u);
+}
+
+}  // namespace
+}  // namespace hysim::engine

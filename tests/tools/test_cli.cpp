@@ -1,0 +1,109 @@
+// The hysim command line, run as a user would: exit codes, messages, outputs.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Output {
+  int exit_code = -1;
+  std::string text;  // stdout and stderr
+};
+
+Output hysim(const std::string& args) {
+  Output out;
+  const std::string cmd = std::string("cd ") + HYSIM_SOURCE_DIR + " && " + HYSIM_BINARY + " " + args + " 2>&1";
+  FILE* pipe = popen(cmd.c_str(), "r");
+  if (pipe == nullptr) return out;
+  std::array<char, 4096> buf;
+  size_t n;
+  while ((n = fread(buf.data(), 1, buf.size(), pipe)) > 0) out.text.append(buf.data(), n);
+  const int status = pclose(pipe);
+  out.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return out;
+}
+
+std::string outDir(const std::string& name) {
+  const fs::path p = fs::path(HYSIM_TEST_OUTPUT_DIR) / "cli" / name;
+  fs::remove_all(p);
+  fs::create_directories(p);
+  return p.string();
+}
+
+TEST(Cli, HelpForEachSubcommand) {
+  for (const char* sub : {"run", "stats"}) {
+    const Output o = hysim(std::string(sub) + " --help");
+    EXPECT_EQ(o.exit_code, 0) << o.text;
+    EXPECT_NE(o.text.find("Usage"), std::string::npos) << o.text;
+  }
+}
+
+TEST(Cli, BadArgumentsExitNonZeroWithAMessage) {
+  Output o = hysim("run --steps minus-three");
+  EXPECT_NE(o.exit_code, 0);
+  EXPECT_NE(o.text.find("--steps"), std::string::npos) << o.text;
+  o = hysim("explode");
+  EXPECT_NE(o.exit_code, 0);
+  o = hysim("stats /nonexistent/mesh.msh");
+  EXPECT_NE(o.exit_code, 0);
+  EXPECT_NE(o.text.find("/nonexistent/mesh.msh"), std::string::npos) << o.text;
+}
+
+TEST(Cli, StatsJsonHasThePaperColumns) {
+  const Output o = hysim("stats assets/uterus_myoma.msh --json");
+  ASSERT_EQ(o.exit_code, 0) << o.text;
+  const auto j = nlohmann::json::parse(o.text);
+  for (const char* key : {"nodes", "elements", "size_min", "size_mean", "size_std", "edge_min", "edge_mean", "edge_std",
+                          "q_min", "q_mean", "q_std", "dihedral_min_deg"}) {
+    EXPECT_TRUE(j.contains(key)) << key;
+  }
+  EXPECT_GE(j["elements"].get<int>(), 10000);
+  EXPECT_GT(j["q_min"].get<double>(), 0.05);  // no slivers
+  EXPECT_LE(j["q_mean"].get<double>(), 1.0 / 3.0);
+}
+
+TEST(Cli, RunWritesFramesAndReport) {
+  const std::string dir = outDir("run");
+  const Output o = hysim("run --steps 20 --every 10 --frames " + dir + "/frames --report " + dir + "/report.json");
+  ASSERT_EQ(o.exit_code, 0) << o.text;
+  EXPECT_TRUE(fs::exists(dir + "/frames/frame_00000.png"));
+  EXPECT_TRUE(fs::exists(dir + "/frames/frame_00002.png"));
+  std::ifstream in(dir + "/report.json");
+  const auto j = nlohmann::json::parse(in);
+  EXPECT_EQ(j["steps"].get<int>(), 20);
+  EXPECT_EQ(j["frames"].get<int>(), 3);
+  EXPECT_DOUBLE_EQ(j["dt"].get<double>(), 0.001);
+  for (const char* key : {"nodes", "elements", "springs", "state_hash", "warnings"}) EXPECT_TRUE(j.contains(key)) << key;
+  EXPECT_TRUE(j["step_us"].contains("median"));
+  EXPECT_TRUE(j["step_us"].contains("p99"));
+  EXPECT_EQ(j["state_hash"].get<std::string>().size(), 16u);
+}
+
+TEST(Cli, BadSceneFailsAndKeepsTheOldReport) {
+  const std::string dir = outDir("bad");
+  std::ofstream(dir + "/report.json") << "{\"kept\": true}\n";
+  std::ofstream(dir + "/bad.yaml") << "name: x\nmesh: " << HYSIM_SOURCE_DIR << "/assets/uterus_myoma.msh\nmaterials: 3\n";
+  const Output o = hysim("run " + dir + "/bad.yaml --report " + dir + "/report.json");
+  EXPECT_EQ(o.exit_code, 1);
+  EXPECT_NE(o.text.find(dir + "/bad.yaml:3"), std::string::npos) << o.text;
+  std::ifstream in(dir + "/report.json");
+  EXPECT_TRUE(nlohmann::json::parse(in)["kept"].get<bool>());
+}
+
+TEST(Cli, SameSceneTwiceSameHash) {
+  const std::string dir = outDir("hash");
+  ASSERT_EQ(hysim("run --steps 100 --quiet --report " + dir + "/a.json").exit_code, 0);
+  ASSERT_EQ(hysim("run --steps 100 --quiet --report " + dir + "/b.json").exit_code, 0);
+  std::ifstream a(dir + "/a.json"), b(dir + "/b.json");
+  EXPECT_EQ(nlohmann::json::parse(a)["state_hash"], nlohmann::json::parse(b)["state_hash"]);
+}
+
+}  // namespace
