@@ -83,7 +83,9 @@ Result<std::unique_ptr<Simulation>> Simulation::create(const Scene& scene) {
   Eigen::VectorXi face_tet;
   s->surface_faces_ = cutting::boundaryFaces(s->mesh_, &face_tet);
   std::vector<int> local(s->mesh_.numNodes(), -1);
-  // A surface vertex is drawn as myoma when it lies on a boundary face of a myoma tet.
+  // A surface vertex is drawn as myoma when all its boundary faces belong to myoma tets:
+  // the rim where the myoma meets the wall keeps the endometrium colour, so the colour
+  // blend happens on the myoma's side (its base is covered by endometrium in reality).
   int myoma_label = -1;
   for (const sim::Material& m : scene.materials) {
     if (m.name == "myoma") myoma_label = m.label;
@@ -94,11 +96,11 @@ Result<std::unique_ptr<Simulation>> Simulation::create(const Scene& scene) {
       if (local[node] < 0) {
         local[node] = static_cast<int>(s->surface_nodes_.size());
         s->surface_nodes_.push_back(node);
-        s->surface_material_.push_back(render::SurfaceMaterial::Endometrium);
+        s->surface_material_.push_back(render::SurfaceMaterial::Myoma);
       }
       s->surface_triangles_.push_back(static_cast<std::uint32_t>(local[node]));
-      if (s->mesh_.material[face_tet[f]] == myoma_label) {
-        s->surface_material_[local[node]] = render::SurfaceMaterial::Myoma;
+      if (s->mesh_.material[face_tet[f]] != myoma_label) {
+        s->surface_material_[local[node]] = render::SurfaceMaterial::Endometrium;
       }
     }
   }

@@ -511,6 +511,38 @@ Image Renderer::render(const RenderSnapshot& snapshot) {
 }
 
 void Renderer::render(const RenderSnapshot& snapshot, Image& out) {
+  draw(snapshot);
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, resolve_fbo_);
+  glReadBuffer(GL_COLOR_ATTACHMENT0);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  out.width = width_;
+  out.height = height_;
+  const std::size_t row = static_cast<std::size_t>(width_) * 4;
+  out.rgba.resize(row * static_cast<std::size_t>(height_));
+  glReadPixels(0, 0, width_, height_, GL_RGBA, GL_UNSIGNED_BYTE, out.rgba.data());
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+
+  // GL's row 0 is the bottom; the Image's row 0 is the top. Swap rows in place.
+  for (int y = 0; y < height_ / 2; ++y) {
+    std::uint8_t* a = out.rgba.data() + static_cast<std::size_t>(y) * row;
+    std::uint8_t* b = out.rgba.data() + static_cast<std::size_t>(height_ - 1 - y) * row;
+    std::swap_ranges(a, a + row, b);
+  }
+}
+
+void Renderer::blitTo(unsigned framebuffer, int x, int y, int w, int h) const {
+  if (w <= 0 || h <= 0) return;
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, resolve_fbo_);
+  glReadBuffer(GL_COLOR_ATTACHMENT0);
+  glBindFramebuffer(GL_DRAW_FRAMEBUFFER, framebuffer);
+  glDisable(GL_SCISSOR_TEST);
+  // Linear filtering: the window's view area rarely has the renderer's size.
+  const GLenum filter = (w == width_ && h == height_) ? GL_NEAREST : GL_LINEAR;
+  glBlitFramebuffer(0, 0, width_, height_, x, y, x + w, y + h, GL_COLOR_BUFFER_BIT, filter);
+  glBindFramebuffer(GL_FRAMEBUFFER, framebuffer);
+}
+
+void Renderer::draw(const RenderSnapshot& snapshot) {
   const Camera& camera = snapshot.camera;
   const CameraMatrices cm = cameraMatrices(camera, width_, height_);
   const std::array<float, 16> view_proj = multiply(cm.projection, cm.view);
@@ -561,22 +593,7 @@ void Renderer::render(const RenderSnapshot& snapshot, Image& out) {
     glBlitFramebuffer(0, 0, width_, height_, 0, 0, width_, height_, GL_COLOR_BUFFER_BIT,
                       GL_NEAREST);
   }
-  glBindFramebuffer(GL_READ_FRAMEBUFFER, resolve_fbo_);
-  glReadBuffer(GL_COLOR_ATTACHMENT0);
-  glPixelStorei(GL_PACK_ALIGNMENT, 1);
-  out.width = width_;
-  out.height = height_;
-  const std::size_t row = static_cast<std::size_t>(width_) * 4;
-  out.rgba.resize(row * static_cast<std::size_t>(height_));
-  glReadPixels(0, 0, width_, height_, GL_RGBA, GL_UNSIGNED_BYTE, out.rgba.data());
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
-
-  // GL's row 0 is the bottom; the Image's row 0 is the top. Swap rows in place.
-  for (int y = 0; y < height_ / 2; ++y) {
-    std::uint8_t* a = out.rgba.data() + static_cast<std::size_t>(y) * row;
-    std::uint8_t* b = out.rgba.data() + static_cast<std::size_t>(height_ - 1 - y) * row;
-    std::swap_ranges(a, a + row, b);
-  }
 }
 
 hysim::Result<std::unique_ptr<OffscreenRenderer>> OffscreenRenderer::create(

@@ -132,11 +132,6 @@ Result<Model> buildModel(const TetMesh& mesh, const std::vector<Material>& mater
     m.damping[s] = sum_bev[s] / (len * len);
   }
 
-  m.packed.resize(ns);
-  for (int s = 0; s < ns; ++s) {
-    m.packed[s] = {m.springs(s, 0), m.springs(s, 1), m.rest_length[s], m.stiffness[s], m.damping[s]};
-  }
-
   m.fixed.assign(n, 0);
   for (int i : fixed_nodes) {
     if (i < 0 || i >= n) return Error{"fixed node index " + std::to_string(i) + " out of range"};
@@ -147,6 +142,13 @@ Result<Model> buildModel(const TetMesh& mesh, const std::vector<Material>& mater
     // Unused nodes (mass 0) are treated as fixed so the step never divides by zero.
     if (m.mass[i] <= 0.0) m.fixed[i] = 1;
     if (!m.fixed[i]) m.inv_mass[i] = 1.0 / m.mass[i];
+  }
+  // A spring between two anchored nodes never changes length: the step skips it.
+  m.packed.clear();
+  m.packed.reserve(ns);
+  for (int s = 0; s < ns; ++s) {
+    if (m.fixed[m.springs(s, 0)] && m.fixed[m.springs(s, 1)]) continue;
+    m.packed.push_back({m.springs(s, 0), m.springs(s, 1), m.rest_length[s], m.stiffness[s], m.damping[s]});
   }
 
   // Stability of symplectic Euler with stiffness damping (zeta = beta*omega/2):

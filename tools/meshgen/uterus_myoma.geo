@@ -18,10 +18,15 @@ canal_z0 = -40; canal_z1 = -20;         // canal runs along z from z0 to z1 (thr
 myo_x = 0; myo_y = -9; myo_z = 4;       // myoma centre (posterior wall, ~6 mm embedded)
 myo_r = 8;                              // myoma radius
 
-h_fine   = 2.3;   // target edge length at the cavity surface and in/around the myoma
-h_coarse = 5.5;   // target edge length towards the outer surface
+// The simulator's explicit substep is set by the highest natural frequency of the
+// mass-spring network, ~ sqrt(E / rho) / (local edge length). The myoma is 2.5x stiffer
+// than the wall (150 vs 60 kPa, wave speed 1.55x), so it gets the larger elements; a
+// nearly uniform size everywhere else keeps short edges away and still gives ~12k tets.
+h_fine   = 2.7;   // target edge length at the cavity, canal and myoma surfaces
+h_myo    = 3.4;   // target edge length in a ball of radius myo_r + 1 around the myoma
+h_coarse = 4.0;   // target edge length towards the outer surface
 d_fine   = 1.0;   // distance from the cavity/myoma surface where growth starts
-d_coarse = 14.0;  // distance where h_coarse would be reached (the wall is ~12 mm: ~5 mm at the outer surface)
+d_coarse = 14.0;  // distance where h_coarse would be reached (the wall is ~12 mm: ~3.8 mm at the outer surface)
 
 // ---- geometry -------------------------------------------------------------
 // Ellipsoids = unit spheres, turned so that their poles lie on the x axis and
@@ -67,8 +72,9 @@ Physical Volume("myometrium", 1) = {wallv()};
 Physical Volume("myoma", 2) = {myoma()};
 
 // ---- mesh size ------------------------------------------------------------
-// Fine at the cavity surface, the canal and the myoma surface, growing into the wall; a
-// ball keeps the whole myoma (and a shell around it) fine.
+// h_fine at the cavity surface, the canal and the myoma surface, growing into the wall
+// towards h_coarse; exactly h_myo inside a ball around the myoma (Max(Min(threshold, ball
+// with h_myo inside), ball with h_myo inside and 0 outside)).
 inner() = Surface In BoundingBox {-cav_a - eps, -cav_b - eps, -cav_c - eps,
                                    cav_a + eps,  cav_b + eps,  cav_c + eps};
 myos() = Surface In BoundingBox {myo_x - myo_r - eps, myo_y - myo_r - eps, myo_z - myo_r - eps,
@@ -79,6 +85,10 @@ If (#inner() != 3 || #myos() != 3 || #canals() != 1)
   Error("uterus_myoma.geo: surface lookup found %g cavity, %g myoma, %g canal surfaces (expected 3, 3, 1)", #inner(), #myos(), #canals());
   Abort;
 EndIf
+// Myoma surfaces: Frontal-Delaunay. MeshAdapt left ~1.1 mm edges around the sphere pole at
+// the top of the bulge (the stiffest nodes of the model). The ellipsoids keep MeshAdapt.
+MeshAlgorithm Surface{myos()} = 6;
+
 Field[1] = Distance;
 Field[1].SurfacesList = {inner(), myos(), canals()};
 Field[1].NNodesByEdge = 200;
@@ -94,24 +104,34 @@ Field[3] = Ball;
 Field[3].XCenter = myo_x; Field[3].YCenter = myo_y; Field[3].ZCenter = myo_z;
 Field[3].Radius = myo_r + 1;
 Field[3].Thickness = 2;
-Field[3].VIn = h_fine;
-Field[3].VOut = h_coarse;
+Field[3].VIn = h_myo;
+Field[3].VOut = 1000;
+
+Field[5] = Ball;
+Field[5].XCenter = myo_x; Field[5].YCenter = myo_y; Field[5].ZCenter = myo_z;
+Field[5].Radius = myo_r + 1;
+Field[5].Thickness = 2;
+Field[5].VIn = h_myo;
+Field[5].VOut = 0;
 
 Field[4] = Min;
 Field[4].FieldsList = {2, 3};
-Background Field = 4;
+Field[6] = Max;
+Field[6].FieldsList = {4, 5};
+Background Field = 6;
 
 Mesh.MeshSizeFromPoints = 0;
 Mesh.MeshSizeFromCurvature = 0;
 Mesh.MeshSizeExtendFromBoundary = 0;
-Mesh.MeshSizeMax = h_coarse;
+Mesh.MeshSizeMax = Max(h_coarse, h_myo);
 
 // ---- meshing options (fixed for determinism) -------------------------------
 General.NumThreads = 1;
 Mesh.MaxNumThreads1D = 1; Mesh.MaxNumThreads2D = 1; Mesh.MaxNumThreads3D = 1;
 Mesh.RandomSeed = 1;
 Mesh.Algorithm = 1;        // MeshAdapt (2D): on these BSpline ellipsoids it gives the best surface
-                           // triangles near the sphere poles (Frontal-Delaunay left slivers there)
+                           // triangles near the sphere poles (Frontal-Delaunay left slivers there);
+                           // the myoma surfaces use Frontal-Delaunay (MeshAlgorithm above)
 Mesh.Algorithm3D = 1;      // Delaunay (3D)
 Mesh.Optimize = 1;
 // Mesh.OptimizeNetgen is not used: Debian's gmsh 4.8.4 is built without Netgen.

@@ -58,6 +58,13 @@ class Renderer {
   Image render(const RenderSnapshot& snapshot);
   // Same, reusing `out`'s storage (no allocation once it has the right size).
   void render(const RenderSnapshot& snapshot, Image& out);
+  // Draws the snapshot into the renderer's framebuffer (resolved if MSAA) without reading
+  // it back: for windowed apps, followed by blitTo().
+  void draw(const RenderSnapshot& snapshot);
+  // Copies the last drawn frame into `framebuffer` (0 = the window's default framebuffer),
+  // scaled into the rectangle (x, y, w, h) in GL window coordinates (origin bottom-left),
+  // and leaves `framebuffer` bound. The target must not be multisampled.
+  void blitTo(unsigned framebuffer, int x, int y, int w, int h) const;
 
   int width() const { return width_; }
   int height() const { return height_; }
@@ -105,6 +112,13 @@ class OffscreenRenderer {
   // Makes this renderer's context current, then draws (see Renderer::render).
   Image render(const RenderSnapshot& snapshot);
   void render(const RenderSnapshot& snapshot, Image& out);
+  // Draws the snapshot into the renderer's framebuffer (resolved if MSAA) without reading
+  // it back: for windowed apps, followed by blitTo().
+  void draw(const RenderSnapshot& snapshot);
+  // Copies the last drawn frame into `framebuffer` (0 = the window's default framebuffer),
+  // scaled into the rectangle (x, y, w, h) in GL window coordinates (origin bottom-left),
+  // and leaves `framebuffer` bound. The target must not be multisampled.
+  void blitTo(unsigned framebuffer, int x, int y, int w, int h) const;
   // Renders and writes a PNG.
   hysim::Status renderToPng(const RenderSnapshot& snapshot, const std::string& path);
 

@@ -63,7 +63,7 @@ struct Model {
   Eigen::VectorXd stiffness;       // #S, g/s^2: Van Gelder k = sum_t E_t V_t / |e|^2
   Eigen::VectorXd damping;         // #S, g/s: c = beta * k
   std::vector<std::uint8_t> fixed; // #N, 1 = anchored (never moves)
-  std::vector<PackedSpring> packed; // #S, same springs as above, for the step
+  std::vector<PackedSpring> packed; // <= #S: the springs above that can move (not both ends anchored)
   std::vector<Material> materials;
 
   ModelOptions options;

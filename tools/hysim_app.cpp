@@ -1,0 +1,328 @@
+// hysim-app: the trainee window. Loads a scene, runs the fixed-step simulation paced to
+// real time, shows the hysteroscope view (SDL2 + OpenGL 3.3) and an ImGui panel with the
+// numbers a trainee and an instructor watch.
+//
+// Pacing is this program's job (the physics never reads the wall clock): wall time is
+// accumulated and the scene's fixed dt is stepped as often as due, with the catch-up
+// capped so a slow machine runs in slow motion instead of freezing the window.
+#include <SDL.h>
+#include <imgui.h>
+
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "hysim/engine/scene.hpp"
+#include "hysim/engine/simulation.hpp"
+#include "hysim/render/image.hpp"
+#include "hysim/render/imgui_layer.hpp"
+#include "hysim/render/renderer.hpp"
+#include "hysim/render/sdl_window.hpp"
+
+namespace fs = std::filesystem;
+using namespace hysim;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+int fail(const std::string& message) {
+  std::cerr << "hysim-app: " << message << "\n";
+  return 1;
+}
+
+std::string defaultScene() {
+  if (fs::exists("scenes/default.yaml")) return "scenes/default.yaml";
+  return std::string(HYSIM_SOURCE_DIR) + "/scenes/default.yaml";
+}
+
+double seconds(Clock::duration d) { return std::chrono::duration<double>(d).count(); }
+
+struct AppArgs {
+  std::string scene;
+  int frames = -1;            // quit after this many frames (-1: never)
+  double quit_after_s = -1.0; // quit after this much wall time (-1: never)
+  std::string screenshot;     // PNG of the last frame, written on exit
+  int width = 1024;
+  int height = 768;
+  bool no_vsync = false;
+  bool paused = false;
+};
+
+// Median of the last kWindow step times, without allocating per frame.
+class StepTimes {
+ public:
+  static constexpr int kWindow = 100;
+  void add(double us) {
+    ring_[next_] = us;
+    next_ = (next_ + 1) % kWindow;
+    count_ = std::min(count_ + 1, kWindow);
+  }
+  double median() {
+    if (count_ == 0) return 0.0;
+    std::copy(ring_.begin(), ring_.begin() + count_, scratch_.begin());
+    auto mid = scratch_.begin() + count_ / 2;
+    std::nth_element(scratch_.begin(), mid, scratch_.begin() + count_);
+    return *mid;
+  }
+  void clear() { count_ = next_ = 0; }
+
+ private:
+  std::array<double, kWindow> ring_{};
+  std::array<double, kWindow> scratch_{};
+  int count_ = 0;
+  int next_ = 0;
+};
+
+// Fixed-step pacing: wall time in, number of steps due out.
+struct Pacer {
+  double dt = 1e-3;
+  double speed = 1.0;               // simulated seconds per wall second (slow motion < 1)
+  double max_frame_s = 0.1;         // at most this much simulated time per frame...
+  double step_budget_s = 1.0 / 15;  // ...and at most this much wall time stepping per frame
+  double accumulator = 0.0;         // simulated time due but not yet stepped
+  double behind_s = 0.0;            // simulated time given up: the machine could not keep up
+
+  int due(double wall_elapsed_s) {
+    double wanted = wall_elapsed_s * speed;
+    if (wanted > max_frame_s) {  // a long stall (window dragged, debugger): do not catch up
+      behind_s += wanted - max_frame_s;
+      wanted = max_frame_s;
+    }
+    accumulator += wanted;
+    const int n = static_cast<int>(std::floor(accumulator / dt));
+    accumulator -= n * dt;
+    return n;
+  }
+  // Called when stepping stopped early (budget): forget the rest instead of piling it up.
+  void drop(int not_stepped) {
+    behind_s += not_stepped * dt + accumulator;
+    accumulator = 0.0;
+  }
+  void reset() { accumulator = behind_s = 0.0; }
+};
+
+struct Panel {
+  bool paused = false;
+  bool reset_requested = false;
+  int lens_index = 2;  // 0, 12, 30 degrees
+  float speed = 1.0f;
+};
+
+constexpr std::array<int, 3> kLens = {0, 12, 30};
+
+int lensIndexFor(double deg) {
+  int best = 0;
+  for (int i = 1; i < 3; ++i) {
+    if (std::fabs(kLens[i] - deg) < std::fabs(kLens[best] - deg)) best = i;
+  }
+  return best;
+}
+
+int runApp(const AppArgs& args) {
+  const std::string scene_path = args.scene.empty() ? defaultScene() : args.scene;
+  auto scene = engine::loadScene(scene_path);
+  if (!scene.ok()) return fail(scene.error());
+  auto created = engine::Simulation::create(*scene);
+  if (!created.ok()) return fail(created.error());
+  std::unique_ptr<engine::Simulation> sim = std::move(created.value());
+
+  render::SdlWindowOptions window_options;
+  window_options.title = "hysim - " + scene->name;
+  window_options.width = args.width;
+  window_options.height = args.height;
+  window_options.vsync = !args.no_vsync;
+  auto window = render::SdlWindow::create(window_options);
+  if (!window.ok()) return fail(window.error());
+  auto renderer = render::Renderer::create(scene->render.width, scene->render.height);
+  if (!renderer.ok()) return fail("cannot create the renderer: " + renderer.error());
+  auto layer = render::ImGuiLayer::create(**window);
+  if (!layer.ok()) return fail(layer.error());
+  std::printf("hysim-app: scene %s (%s); %s\n", scene->name.c_str(), scene_path.c_str(),
+              (*window)->description().c_str());
+
+  Panel panel;
+  panel.paused = args.paused;
+  panel.lens_index = lensIndexFor(scene->camera.lens_deg);
+  Pacer pacer;
+  pacer.dt = scene->sim.dt;
+  StepTimes step_times;
+  render::RenderSnapshot snapshot;
+  double max_force_n = 0.0;
+  double frame_ms = 0.0;   // smoothed wall time per frame
+  double realtime = 0.0;   // smoothed simulated seconds per wall second
+  const double path_end_s = haptics::Trajectory(scene->tool_path).duration();
+
+  const Clock::time_point start = Clock::now();
+  Clock::time_point last = start;
+  long frame = 0;
+  bool quit = false;
+  while (true) {
+    // Events. Every way out (Esc, window close, --frames, --quit-after-s) still draws this
+    // frame, so --screenshot always gets a complete last frame.
+    SDL_Event event;
+    while (SDL_PollEvent(&event)) {
+      const bool taken = (*layer)->processEvent(event);
+      if (event.type == SDL_QUIT) quit = true;
+      if (event.type == SDL_WINDOWEVENT && event.window.event == SDL_WINDOWEVENT_CLOSE &&
+          event.window.windowID == SDL_GetWindowID((*window)->nativeWindow())) {
+        quit = true;
+      }
+      if (event.type == SDL_KEYDOWN && !taken && event.key.repeat == 0) {
+        switch (event.key.keysym.sym) {
+          case SDLK_ESCAPE: quit = true; break;
+          case SDLK_SPACE: panel.paused = !panel.paused; break;
+          case SDLK_r: panel.reset_requested = true; break;
+          case SDLK_l: panel.lens_index = (panel.lens_index + 1) % 3; break;
+          default: break;
+        }
+      }
+    }
+
+    const Clock::time_point now = Clock::now();
+    const double elapsed = seconds(now - last);
+    last = now;
+    if (args.frames >= 0 && frame + 1 >= args.frames) quit = true;
+    if (args.quit_after_s >= 0.0 && seconds(now - start) >= args.quit_after_s) quit = true;
+
+    if (panel.reset_requested) {
+      panel.reset_requested = false;
+      auto fresh = engine::Simulation::create(*scene);
+      if (!fresh.ok()) return fail("reset: " + fresh.error());
+      sim = std::move(fresh.value());
+      pacer.reset();
+      step_times.clear();
+      max_force_n = 0.0;
+    }
+
+    // Fixed steps due for the wall time since the last frame.
+    const double sim_before = sim->state().time;
+    if (!panel.paused) {
+      pacer.speed = panel.speed;
+      const int due = pacer.due(elapsed);
+      const Clock::time_point budget_end =
+          now + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(pacer.step_budget_s));
+      for (int i = 0; i < due; ++i) {
+        const Clock::time_point t0 = Clock::now();
+        if (t0 >= budget_end) {
+          pacer.drop(due - i);
+          break;
+        }
+        sim->step();
+        step_times.add(1e6 * seconds(Clock::now() - t0));
+      }
+    }
+    const double tool_force_n = sim->toolForceN().norm();
+    max_force_n = std::max(max_force_n, tool_force_n);
+    if (elapsed > 0.0) {
+      const double a = std::min(1.0, elapsed / 0.5);  // ~0.5 s smoothing
+      frame_ms += a * (1e3 * elapsed - frame_ms);
+      realtime += a * ((sim->state().time - sim_before) / elapsed - realtime);
+    }
+
+    // The scope view.
+    sim->fillSnapshot(snapshot);
+    snapshot.camera.lens_deg = static_cast<float>(kLens[panel.lens_index]);
+    (*renderer)->draw(snapshot);
+
+    int dw = 0, dh = 0, ww = 0, wh = 0;
+    (*window)->drawableSize(dw, dh);
+    SDL_GetWindowSize((*window)->nativeWindow(), &ww, &wh);
+    const float scale = ww > 0 ? static_cast<float>(dw) / static_cast<float>(ww) : 1.0f;
+    const float panel_w = 300.0f;  // screen coordinates
+    const int panel_px = static_cast<int>(panel_w * scale);
+    const int area_w = std::max(dw - panel_px, 1), area_h = std::max(dh, 1);
+    const double fit = std::min(static_cast<double>(area_w) / (*renderer)->width(),
+                                static_cast<double>(area_h) / (*renderer)->height());
+    const int vw = static_cast<int>((*renderer)->width() * fit);
+    const int vh = static_cast<int>((*renderer)->height() * fit);
+    (*window)->clear(0.08f, 0.08f, 0.09f);
+    (*renderer)->blitTo(0, panel_px + (area_w - vw) / 2, (area_h - vh) / 2, vw, vh);
+
+    // The panel.
+    (*layer)->newFrame();
+    ImGui::SetNextWindowPos(ImVec2(0, 0));
+    ImGui::SetNextWindowSize(ImVec2(panel_w, static_cast<float>(wh)));
+    ImGui::Begin("hysim", nullptr,
+                 ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse);
+    ImGui::TextWrapped("%s", scene->description.empty() ? scene->name.c_str() : scene->description.c_str());
+    ImGui::Separator();
+    const sim::State& st = sim->state();
+    if (panel.paused) ImGui::TextColored(ImVec4(0.4f, 0.8f, 1.0f, 1.0f), "PAUSED");
+    ImGui::Text("sim time     %8.3f s", st.time);
+    ImGui::Text("steps        %8llu  (dt %.3g ms)", static_cast<unsigned long long>(st.steps),
+                1e3 * scene->sim.dt);
+    ImGui::Text("step time    %8.1f us  (median of %d)", step_times.median(), StepTimes::kWindow);
+    ImGui::Text("substeps     %8d", sim->model().substeps);
+    ImGui::Text("real time    %8.2f x", realtime);
+    ImGui::Text("frame        %8.1f ms", frame_ms);
+    if (pacer.behind_s > 0.05) {
+      // The simulation is never skipped ahead: a too slow machine runs in slow motion.
+      ImGui::TextColored(ImVec4(1.0f, 0.75f, 0.3f, 1.0f), "behind real time by %.2f s", pacer.behind_s);
+    }
+    ImGui::Separator();
+    ImGui::Text("tool force   %8.3f N", tool_force_n);
+    ImGui::Text("max force    %8.3f N", max_force_n);
+    if (st.warnings > 0) {
+      ImGui::TextColored(ImVec4(1.0f, 0.35f, 0.3f, 1.0f), "warnings     %8d  (numerical trouble)", st.warnings);
+    } else {
+      ImGui::Text("warnings     %8d", st.warnings);
+    }
+    ImGui::Text("tool path    %s", st.time < path_end_s ? "scripted" : "done (holding last pose)");
+    ImGui::Separator();
+    if (ImGui::Button(panel.paused ? "Resume (Space)" : "Pause (Space)", ImVec2(-1, 0))) {
+      panel.paused = !panel.paused;
+    }
+    if (ImGui::Button("Reset (R)", ImVec2(-1, 0))) panel.reset_requested = true;
+    ImGui::SliderFloat("speed", &panel.speed, 0.05f, 1.0f, "%.2fx");
+    ImGui::Text("lens (L)");
+    for (int i = 0; i < 3; ++i) {
+      char label[16];
+      std::snprintf(label, sizeof(label), "%d deg", kLens[i]);
+      if (i > 0) ImGui::SameLine();
+      ImGui::RadioButton(label, &panel.lens_index, i);
+    }
+    ImGui::Separator();
+    ImGui::TextDisabled("scope follows the scene's scripted path");
+    ImGui::TextDisabled("Esc: quit");
+    ImGui::End();
+    (*layer)->render();
+
+    ++frame;
+    if (quit && !args.screenshot.empty()) {
+      const render::Image shot = (*window)->readBackBuffer();
+      if (Status s = render::writePng(args.screenshot, shot); !s.ok()) return fail(s.error());
+      std::printf("hysim-app: screenshot %s (%dx%d)\n", args.screenshot.c_str(), shot.width, shot.height);
+    }
+    (*window)->swapBuffers();
+    if (quit) break;
+  }
+  std::printf("hysim-app: %ld frames, sim time %.3f s, %llu steps, warnings %d\n", frame, sim->state().time,
+              static_cast<unsigned long long>(sim->state().steps), sim->state().warnings);
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"hysim-app: hysteroscopy training simulator window (SDL2 + ImGui)"};
+  AppArgs args;
+  app.add_option("scene", args.scene, "Scene file (default: scenes/default.yaml)")->check(CLI::ExistingFile);
+  app.add_option("--frames", args.frames, "Quit after N frames")->check(CLI::PositiveNumber);
+  app.add_option("--quit-after-s", args.quit_after_s, "Quit after S seconds of wall time")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--screenshot", args.screenshot, "Save the last window frame as PNG on exit");
+  app.add_option("--width", args.width, "Window width")->check(CLI::Range(320, 16384));
+  app.add_option("--height", args.height, "Window height")->check(CLI::Range(240, 16384));
+  app.add_flag("--no-vsync", args.no_vsync, "Do not wait for the display's refresh");
+  app.add_flag("--paused", args.paused, "Start paused");
+  CLI11_PARSE(app, argc, argv);
+  return runApp(args);
+}
