@@ -14,6 +14,7 @@
 #include "hysim/engine/scene.hpp"
 #include "hysim/engine/simulation.hpp"
 #include "hysim/render/renderer.hpp"
+#include "cli_cut2d.hpp"
 
 namespace fs = std::filesystem;
 using namespace hysim;
@@ -164,7 +165,10 @@ int main(int argc, char** argv) {
   stats_cmd->add_option("mesh", stats_path, "Mesh file (.msh or .vtk)")->required()->check(CLI::ExistingFile);
   stats_cmd->add_flag("--json", stats_json, "Print JSON");
 
+  auto cut2d_commands = hysim::tools::addCut2dCommands(app);  // hysim cut, hysim tables
+
   CLI11_PARSE(app, argc, argv);
+  if (auto rc = hysim::tools::runCut2dCommands(*cut2d_commands)) return *rc;
   if (*run_cmd) return runCommand(run);
   if (*stats_cmd) return statsCommand(stats_path, stats_json);
   return 1;

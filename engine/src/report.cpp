@@ -34,6 +34,7 @@ Result<RunReport> run(Simulation& sim, const RunOptions& options) {
   r.dt = scene.sim.dt;
   r.nodes = sim.mesh().numNodes();
   r.elements = sim.mesh().numTets();
+  r.deformable_elements = sim.numDeformableTets();
   r.springs = static_cast<int>(sim.model().springs.rows());
   r.anchored = sim.numAnchored();
   r.substeps = sim.model().substeps;
@@ -82,6 +83,7 @@ std::string reportJson(const RunReport& r) {
   j["dt"] = r.dt;
   j["nodes"] = r.nodes;
   j["elements"] = r.elements;
+  j["deformable_elements"] = r.deformable_elements;
   j["springs"] = r.springs;
   j["anchored_nodes"] = r.anchored;
   j["substeps"] = r.substeps;

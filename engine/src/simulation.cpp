@@ -76,6 +76,11 @@ Result<std::unique_ptr<Simulation>> Simulation::create(const Scene& scene) {
   if (!model.ok()) return Error{scene.path + ": " + model.error()};
   s->model_ = std::move(model.value());
   s->state_ = sim::makeState(s->model_, s->mesh_);
+  for (int t = 0; t < s->mesh_.numTets(); ++t) {
+    bool moves = false;
+    for (int c = 0; c < 4; ++c) moves = moves || !s->model_.fixed[s->mesh_.T(t, c)];
+    s->num_deformable_tets_ += moves ? 1 : 0;
+  }
   s->path_ = haptics::Trajectory(scene.tool_path);
   s->pose_ = s->path_.sample(0.0);
 

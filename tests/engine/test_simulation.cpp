@@ -26,6 +26,7 @@ TEST(Simulation, DefaultSceneIsBigEnoughAndStable) {
     deformable += moves;
   }
   EXPECT_GE(deformable, 10000);
+  EXPECT_EQ(deformable, (*sim)->numDeformableTets());
   EXPECT_GT((*sim)->numAnchored(), 0);
   EXPECT_LE((*sim)->model().substep, 0.85 * (*sim)->model().critical_dt * 1.0001);
   for (int i = 0; i < 300; ++i) (*sim)->step();

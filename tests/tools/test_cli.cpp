@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <sstream>
 #include <string>
 
 namespace {
@@ -68,6 +69,38 @@ TEST(Cli, StatsJsonHasThePaperColumns) {
   EXPECT_GE(j["elements"].get<int>(), 10000);
   EXPECT_GT(j["q_min"].get<double>(), 0.05);  // no slivers
   EXPECT_LE(j["q_mean"].get<double>(), 1.0 / 3.0);
+}
+
+// `hysim stats` against an independent implementation (tools/meshgen/mesh-quality.awk, plain
+// awk arithmetic written separately from the C++) on the checked-in uterus mesh.
+TEST(Cli, StatsAgreeWithIndependentAwkComputation) {
+  const Output o = hysim("stats assets/uterus_myoma.msh --json");
+  ASSERT_EQ(o.exit_code, 0) << o.text;
+  const auto j = nlohmann::json::parse(o.text);
+  Output awk;
+  {
+    const std::string cmd = std::string("cd ") + HYSIM_SOURCE_DIR +
+                            " && awk -f tools/meshgen/mesh-quality.awk assets/uterus_myoma.msh | grep '^all '";
+    FILE* pipe = popen(cmd.c_str(), "r");
+    ASSERT_NE(pipe, nullptr);
+    char buf[512] = {0};
+    ASSERT_NE(fgets(buf, sizeof(buf), pipe), nullptr);
+    pclose(pipe);
+    awk.text = buf;
+  }
+  // all  tets vol_min vol_sum e_min e_mean(per tet) e_max q_min q_mean q<.1 dih_min dih_max inv
+  std::istringstream in(awk.text);
+  std::string tag;
+  double tets, vol_min, vol_sum, e_min, e_mean, e_max, q_min, q_mean, q_low, dih_min;
+  in >> tag >> tets >> vol_min >> vol_sum >> e_min >> e_mean >> e_max >> q_min >> q_mean >> q_low >> dih_min;
+  ASSERT_EQ(tag, "all") << awk.text;
+  EXPECT_EQ(j["elements"].get<int>(), static_cast<int>(tets));
+  EXPECT_NEAR(j["size_min"].get<double>(), vol_min, 1e-4);
+  EXPECT_NEAR(j["size_mean"].get<double>(), vol_sum / tets, 1e-3);
+  EXPECT_NEAR(j["edge_min"].get<double>(), e_min, 1e-3);
+  EXPECT_NEAR(j["q_min"].get<double>(), q_min, 1e-4);
+  EXPECT_NEAR(j["q_mean"].get<double>(), q_mean, 1e-4);
+  EXPECT_NEAR(j["dihedral_min_deg"].get<double>(), dih_min, 1e-2);
 }
 
 TEST(Cli, RunWritesFramesAndReport) {

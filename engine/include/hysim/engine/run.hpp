@@ -21,7 +21,7 @@ struct RunReport {
   std::string integrator;
   int steps = 0;
   double dt = 0.0;             // s
-  int nodes = 0, elements = 0, springs = 0, anchored = 0;
+  int nodes = 0, elements = 0, deformable_elements = 0, springs = 0, anchored = 0;
   int substeps = 1;
   double critical_dt = 0.0;    // s
   double step_us_median = 0.0, step_us_p99 = 0.0, step_us_max = 0.0;

@@ -31,6 +31,7 @@ class Simulation {
   const sim::State& state() const { return state_; }
   const haptics::ToolPose& toolPose() const { return pose_; }
   int numAnchored() const { return num_anchored_; }
+  int numDeformableTets() const { return num_deformable_tets_; }  // tets with at least one free node
   int numSurfaceNodes() const { return static_cast<int>(surface_nodes_.size()); }
   // Reaction force on the tool from tissue contact in the last step, newtons.
   const Eigen::Vector3d& toolForceN() const { return tool_force_n_; }
@@ -59,6 +60,7 @@ class Simulation {
   Eigen::Vector3d tool_force_n_{0, 0, 0};
   render::SurfaceMesh tool_surface_;              // body frame
   int num_anchored_ = 0;
+  int num_deformable_tets_ = 0;
 };
 
 // Loads a surface (OBJ, STL, PLY, glTF...) with assimp, triangulated, in millimetres.

@@ -1,0 +1,248 @@
+// Mesh optimisation after a 2D cut (Fig. 1 of the paper), run before the two sides are
+// separated (the cut nodes are fixed in the regularisation, so the order does not change
+// the result, and collapses need to be done only once for both sides):
+//   (a) edge collapse of short edges on the cut, and down to about length / mean edge
+//       segments, so the node count stays constant;
+//   (b) equal node distribution along the cut;
+//   (c) local regularisation: nodes one or two edge steps from the cut move under a combined
+//       mass-spring / particle system (constant masses, heavy damping), everything else
+//       (cut and border nodes included) fixed, until the largest move is below 2% of the
+//       mean edge length. A move that would fold or flatten an element is not taken.
+#include <algorithm>
+#include <cmath>
+
+#include "cut2d_internal.hpp"
+
+namespace hysim::cutting::detail {
+namespace {
+
+bool contains(const std::array<int, 3>& v, int x) { return v[0] == x || v[1] == x || v[2] == x; }
+
+// Collapses r into s (s keeps its position). Returns false, changing nothing, when the
+// link condition fails or an element would get quality < minQuality.
+bool tryCollapse(Work& w, int r, int s, double minQuality) {
+  // Link condition: the common neighbours of r and s are exactly the third nodes of the
+  // triangles on edge (r, s).
+  std::vector<int> nr, ns, third;
+  w.neighbours(r, nr);
+  w.neighbours(s, ns);
+  for (int t : w.nodeTris[r])
+    if (contains(w.tris[t].v, s))
+      for (int k = 0; k < 3; ++k)
+        if (w.tris[t].v[k] != r && w.tris[t].v[k] != s) third.push_back(w.tris[t].v[k]);
+  if (third.empty()) return false;
+  for (int x : nr)
+    if (x != s && std::find(ns.begin(), ns.end(), x) != ns.end() && std::find(third.begin(), third.end(), x) == third.end())
+      return false;
+  // Geometry of the triangles that keep r (renamed s).
+  const Vec2 ps = w.nodes[s].p;
+  for (int t : w.nodeTris[r]) {
+    const auto& v = w.tris[t].v;
+    if (contains(v, s)) continue;
+    Vec2 c[3];
+    for (int k = 0; k < 3; ++k) c[k] = v[k] == r ? ps : w.nodes[v[k]].p;
+    if (triQuality(c[0], c[1], c[2]) < minQuality) return false;
+  }
+  const std::vector<int> around = w.nodeTris[r];
+  for (int t : around) {
+    if (contains(w.tris[t].v, s)) {
+      w.killTri(t);
+      continue;
+    }
+    auto v = w.tris[t].v;
+    for (int k = 0; k < 3; ++k)
+      if (v[k] == r) v[k] = s;
+    const int mat = w.tris[t].material;
+    w.killTri(t);
+    w.addTri(v[0], v[1], v[2], mat);
+  }
+  w.nodes[r].alive = false;
+  w.nodes[r].merged_into = s;
+  return true;
+}
+
+double chainLength(const Work& w, const std::vector<int>& ch) {
+  double L = 0;
+  for (std::size_t i = 0; i + 1 < ch.size(); ++i) L += (w.nodes[ch[i + 1]].p - w.nodes[ch[i]].p).norm();
+  return L;
+}
+
+void collapseOnCut(Work& w, std::vector<int>& ch, double h, const Cut2DOptions& o, Cut2DReport& rep) {
+  if (ch.size() < 3) return;
+  const int target = std::max(1, static_cast<int>(std::lround(chainLength(w, ch) / h)));
+  for (int guard = 0; guard < 1000; ++guard) {
+    const int segs = static_cast<int>(ch.size()) - 1;
+    if (segs <= 1) return;
+    // Segments by length, shortest first.
+    std::vector<std::pair<double, int>> order;
+    for (int i = 0; i < segs; ++i) order.push_back({(w.nodes[ch[i + 1]].p - w.nodes[ch[i]].p).norm(), i});
+    std::sort(order.begin(), order.end());
+    bool done = false;
+    for (const auto& [len, i] : order) {
+      if (segs <= target && len >= o.optimize.collapse_ratio * h) return;
+      // Candidates to remove: not an end of the chain, not on the border; new nodes first.
+      int cand[2] = {ch[i + 1], ch[i]};
+      int pos[2] = {i + 1, i};
+      if (w.nodes[cand[1]].old < 0 && w.nodes[cand[0]].old >= 0) {
+        std::swap(cand[0], cand[1]);
+        std::swap(pos[0], pos[1]);
+      }
+      for (int k = 0; k < 2 && !done; ++k) {
+        const int r = cand[k], s = cand[1 - k];
+        if (pos[k] == 0 || pos[k] == segs || w.isBorderNode(r)) continue;
+        if (tryCollapse(w, r, s, o.min_quality)) {
+          ch.erase(ch.begin() + pos[k]);
+          ++rep.collapsed_edges;
+          done = true;
+        }
+      }
+      if (done) break;
+    }
+    if (!done) return;
+  }
+}
+
+// Point at arc length `a` along the polyline through `pts`.
+Vec2 atArcLength(const std::vector<Vec2>& pts, double a) {
+  for (std::size_t i = 0; i + 1 < pts.size(); ++i) {
+    const double l = (pts[i + 1] - pts[i]).norm();
+    if (a <= l || i + 2 == pts.size()) return l > 0 ? pts[i] + (std::min(a, l) / l) * (pts[i + 1] - pts[i]) : pts[i];
+    a -= l;
+  }
+  return pts.back();
+}
+
+void distributeOnCut(Work& w, const std::vector<int>& ch, double minQuality) {
+  if (ch.size() < 3) return;
+  // Pieces between anchors (the ends and border nodes).
+  std::size_t start = 0;
+  for (std::size_t end = 1; end < ch.size(); ++end) {
+    if (end + 1 != ch.size() && !w.isBorderNode(ch[end])) continue;
+    if (end - start >= 2) {
+      std::vector<Vec2> pts;
+      for (std::size_t i = start; i <= end; ++i) pts.push_back(w.nodes[ch[i]].p);
+      double L = 0;
+      for (std::size_t i = 0; i + 1 < pts.size(); ++i) L += (pts[i + 1] - pts[i]).norm();
+      const double n = static_cast<double>(end - start);
+      for (std::size_t i = start + 1; i < end; ++i) {
+        const Vec2 target = atArcLength(pts, L * static_cast<double>(i - start) / n);
+        const int node = ch[i];
+        const double before = w.minQualityAround(node);
+        // Full move, or half of it, if that keeps the elements good enough.
+        for (double f : {1.0, 0.5}) {
+          const Vec2 p = w.nodes[node].p + f * (target - w.nodes[node].p);
+          const double after = w.minQualityIfMoved(node, p);
+          if (after > 0 && (after >= minQuality || after >= before)) {
+            w.nodes[node].p = p;
+            break;
+          }
+        }
+      }
+    }
+    start = end;
+  }
+}
+
+void regularise(Work& w, const Chains& chains, double meanEdge, const Cut2DOptions& o, Cut2DReport& rep) {
+  const auto& oo = o.optimize;
+  const int N = static_cast<int>(w.nodes.size());
+  std::vector<int> ring(N, -1);
+  std::vector<int> frontier, next, nb;
+  for (const auto& ch : chains)
+    for (int n : ch)
+      if (ring[n] < 0) {
+        ring[n] = 0;
+        frontier.push_back(n);
+      }
+  std::vector<int> movable;
+  for (int r = 1; r <= oo.rings; ++r) {
+    next.clear();
+    for (int n : frontier) {
+      w.neighbours(n, nb);
+      for (int x : nb)
+        if (ring[x] < 0) {
+          ring[x] = r;
+          next.push_back(x);
+          if (!w.isBorderNode(x)) movable.push_back(x);
+        }
+    }
+    frontier.swap(next);
+  }
+  rep.regularised_nodes = static_cast<int>(movable.size());
+  if (movable.empty()) return;
+  // Compact neighbour lists (CSR) and the mean local edge length.
+  std::vector<int> start{0}, adj;
+  double L0 = 0;
+  int ne = 0;
+  for (int n : movable) {
+    w.neighbours(n, nb);
+    for (int x : nb) {
+      adj.push_back(x);
+      L0 += (w.nodes[x].p - w.nodes[n].p).norm();
+      ++ne;
+    }
+    start.push_back(static_cast<int>(adj.size()));
+  }
+  L0 /= std::max(ne, 1);
+  const double stop = oo.stop_fraction * meanEdge;
+  const double minArea2 = 1e-3 * L0 * L0;  // never flatten: twice the area stays above this
+  const int M = static_cast<int>(movable.size());
+  std::vector<Vec2> vel(M, Vec2::Zero()), force(M);
+  const double damping = 0.1;  // fraction of velocity kept per step (heavy damping)
+  int it = 0;
+  for (; it < oo.max_iterations; ++it) {
+    for (int i = 0; i < M; ++i) {
+      const Vec2 xi = w.nodes[movable[i]].p;
+      Vec2 f = Vec2::Zero();
+      for (int k = start[i]; k < start[i + 1]; ++k) {
+        const Vec2 d = w.nodes[adj[k]].p - xi;
+        const double r = d.norm();
+        if (r <= 1e-12 * L0) continue;
+        // Spring towards the rest length L0 (alpha), particle repulsion inside L0 (beta):
+        // magnitude L0^2/r - r, unbounded as r -> 0, capped at L0 for stability.
+        double mag = oo.spring_weight * (r - L0);
+        if (r < L0) mag -= oo.particle_weight * std::min(L0 * L0 / r - r, L0);
+        f += (mag / r) * d;
+      }
+      force[i] = f;
+    }
+    double maxMove = 0;
+    for (int i = 0; i < M; ++i) {
+      const int n = movable[i];
+      vel[i] = damping * vel[i] + oo.step_gain * force[i];
+      const Vec2 p = w.nodes[n].p + vel[i];
+      bool ok = true;
+      for (int t : w.nodeTris[n]) {
+        const auto& v = w.tris[t].v;
+        Vec2 c[3];
+        for (int k = 0; k < 3; ++k) c[k] = v[k] == n ? p : w.nodes[v[k]].p;
+        if (orient(c[0], c[1], c[2]) <= minArea2) {
+          ok = false;
+          break;
+        }
+      }
+      if (!ok) {
+        vel[i].setZero();
+        continue;
+      }
+      maxMove = std::max(maxMove, vel[i].norm());
+      w.nodes[n].p = p;
+    }
+    if (maxMove < stop) {
+      ++it;
+      break;
+    }
+  }
+  rep.regularisation_iterations = it;
+}
+
+}  // namespace
+
+void optimizeAfterCut(Work& w, Chains& chains, double meanEdge, const Cut2DOptions& options, Cut2DReport& report) {
+  for (auto& ch : chains) collapseOnCut(w, ch, meanEdge, options, report);
+  if (options.optimize.distribute)
+    for (const auto& ch : chains) distributeOnCut(w, ch, options.min_quality);
+  if (options.optimize.rings > 0) regularise(w, chains, meanEdge, options, report);
+}
+
+}  // namespace hysim::cutting::detail
