@@ -23,14 +23,14 @@ cutting::TriMesh table1Mesh(int which) {
   DistMeshOptions o;
   if (which == 1) {
     // A 100 x 66 rectangle (straight borders, four corner features).
-    o.h0 = 16.3;
+    o.h0 = 15.0;
     o.box_min = {0, 0};
     o.box_max = {100, 66};
     o.fixed = {{0, 0}, {100, 0}, {100, 66}, {0, 66}};
     return distmesh2d(rectangleDistance(0, 0, 100, 66), o);
   }
   // A disc of radius 22 (curved border, no features).
-  o.h0 = 3.45;
+  o.h0 = 3.2;
   o.box_min = {-22, -22};
   o.box_max = {22, 22};
   return distmesh2d(circleDistance(0, 0, 22), o);
@@ -63,7 +63,7 @@ int runTable1(const Table1Options& opt) {
   // Complete straight cuts through the whole mesh (the segment ends outside).
   const std::vector<Case> cases = {
       {"1a", 1, {-5, 27}, {105, 41}},
-      {"1b", 1, {20, -5}, {75, 71}},
+      {"1b", 1, {-5, 60}, {105, 8}},
       {"2a", 2, {-25, -6}, {25, 3}},
       {"2b", 2, {-18, -18}, {20, 17}},
   };

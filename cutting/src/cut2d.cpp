@@ -16,7 +16,7 @@
 
 #include <algorithm>
 #include <chrono>
-#include <cstring>
+#include <map>
 #include <cmath>
 #include <numeric>
 #include <string>
@@ -262,8 +262,11 @@ void displaceNodes(Work& w, const Polyline& pl, const std::vector<std::vector<Ev
       if (e.vertex) continue;
       const bool nearA = e.t < 0.5;
       const double frac = nearA ? e.t : 1 - e.t;
-      if (frac >= region) continue;
-      cands.push_back({nearA ? e.a : e.b, frac, e.p, w.isBorderEdge(e.a, e.b)});
+      const bool borderEdge = w.isBorderEdge(e.a, e.b);
+      // On a border edge the nearer node may slide along the border up to the middle (a
+      // border subdivision would add a node that the optimisation cannot move away).
+      if (frac >= (borderEdge ? std::max(region, 0.5001) : region)) continue;
+      cands.push_back({nearA ? e.a : e.b, frac, e.p, borderEdge});
     }
   std::stable_sort(cands.begin(), cands.end(), [](const Candidate& x, const Candidate& y) { return x.frac < y.frac; });
   std::vector<char> done(w.nodes.size(), 0);
@@ -576,13 +579,8 @@ Result<Cut2DResult> finish(const TriMesh& in, Work& w, const Chains& chains) {
     // side with different copies of its nodes; copies share their source's position, so
     // each node is mapped back to its chain node by exact position.
     std::unordered_map<std::uint64_t, char> chainEdge;
-    std::unordered_map<std::uint64_t, int> byPos;
-    auto posKey = [&](const Vec2& p) {
-      std::uint64_t hx, hy;
-      std::memcpy(&hx, &p.x(), 8);
-      std::memcpy(&hy, &p.y(), 8);
-      return hx * 0x9E3779B97F4A7C15ull ^ hy;
-    };
+    std::map<std::pair<double, double>, int> byPos;
+    auto posKey = [](const Vec2& p) { return std::pair<double, double>(p.x(), p.y()); };
     for (const auto& ch : chains)
       for (int n : ch) byPos[posKey(w.nodes[n].p)] = n;
     for (const auto& ch : chains)

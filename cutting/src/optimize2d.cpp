@@ -163,10 +163,33 @@ void regularise(Work& w, const Chains& chains, double meanEdge, const Cut2DOptio
         if (ring[x] < 0) {
           ring[x] = r;
           next.push_back(x);
-          if (!w.isBorderNode(x)) movable.push_back(x);
+          movable.push_back(x);
         }
     }
     frontier.swap(next);
+  }
+  // Border nodes slide along the border where it is straight (their two border edges
+  // collinear); elsewhere on the border (curves, corners) they stay.
+  std::vector<Vec2> tangent;
+  {
+    std::vector<int> keep;
+    for (int n : movable) {
+      if (!w.isBorderNode(n)) {
+        keep.push_back(n);
+        tangent.push_back(Vec2::Zero());
+        continue;
+      }
+      w.neighbours(n, nb);
+      std::vector<int> bn;
+      for (int x : nb)
+        if (w.isBorderEdge(n, x)) bn.push_back(x);
+      if (bn.size() != 2) continue;
+      const Vec2 d0 = w.nodes[n].p - w.nodes[bn[0]].p, d1 = w.nodes[bn[1]].p - w.nodes[n].p;
+      if (std::abs(cross2(d0, d1)) > 1e-12 * d0.norm() * d1.norm() || d0.dot(d1) <= 0) continue;
+      keep.push_back(n);
+      tangent.push_back(d0.normalized());
+    }
+    movable.swap(keep);
   }
   rep.regularised_nodes = static_cast<int>(movable.size());
   if (movable.empty()) return;
@@ -210,8 +233,12 @@ void regularise(Work& w, const Chains& chains, double meanEdge, const Cut2DOptio
     for (int i = 0; i < M; ++i) {
       const int n = movable[i];
       vel[i] = damping * vel[i] + oo.step_gain * force[i];
+      if (tangent[i].x() != 0 || tangent[i].y() != 0) vel[i] = vel[i].dot(tangent[i]) * tangent[i];
       const Vec2 p = w.nodes[n].p + vel[i];
+      // Never fold or flatten an element, and never push the worst element around the node
+      // below min(its current quality, quality_guard).
       bool ok = true;
+      double qBefore = 1.0, qAfter = 1.0;
       for (int t : w.nodeTris[n]) {
         const auto& v = w.tris[t].v;
         Vec2 c[3];
@@ -220,7 +247,10 @@ void regularise(Work& w, const Chains& chains, double meanEdge, const Cut2DOptio
           ok = false;
           break;
         }
+        qAfter = std::min(qAfter, triQuality(c[0], c[1], c[2]));
+        qBefore = std::min(qBefore, triQuality(w.nodes[v[0]].p, w.nodes[v[1]].p, w.nodes[v[2]].p));
       }
+      if (ok && qAfter < std::min(qBefore, oo.quality_guard)) ok = false;
       if (!ok) {
         vel[i].setZero();
         continue;

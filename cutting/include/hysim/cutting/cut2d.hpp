@@ -36,6 +36,9 @@ struct Optimize2DOptions {
   double step_gain = 0.12;           // dt^2 / (m + dt c): heavy damping, constant masses
   double stop_fraction = 0.02;       // stop when the largest move < this * mean edge length
   int max_iterations = 300;
+  // A regularisation move is refused when it would leave the worst element around the node
+  // below min(its quality before the move, quality_guard).
+  double quality_guard = 0.35;
 };
 
 struct Cut2DOptions {

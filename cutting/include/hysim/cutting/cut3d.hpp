@@ -1,0 +1,108 @@
+#pragma once
+// Cutting tetrahedral meshes with a plane or an open triangulated surface: the hybrid method
+// of section 4 of the paper (per intersected edge, snap the near node onto the cut or
+// subdivide near the middle; zero to three nodes of a tet separated), a local 3D mesh
+// optimisation after the cut (beyond the paper), and the baselines with the same interface
+// (standard subdivision, snapping only, element deletion).
+//
+// Outline of one cut (cut3d.cpp):
+//  1. classify nodes against the surface (tolerance eps, see cut_surface.hpp); find the
+//     crossed edges (end points strictly on opposite sides, crossing inside the surface);
+//  2. hybrid/snap: a node whose crossing lies within snap_region * |e| of it moves onto the
+//     cut (interior node: nearest point of the cut; boundary node: along a crossed boundary
+//     edge, only where its boundary is flat, i.e. not a feature). A move that would invert,
+//     flatten or badly degrade (q* below min(before, min_quality)) an element, or shorten an
+//     edge below min_edge_fraction of its length, is refused and the edges stay crossed;
+//  3. every edge still crossed is split at the crossing (conforming edge bisection: each tet
+//     around the edge becomes two), which gives the subdivided configurations (1-3 and 2-2
+//     splits into 4 and 6 tets, partial patterns where the surface ends inside the tet);
+//  4. node separation: faces lying in the cut and shared by two tets are cut faces; each node
+//     on the cut gets one copy per group of its incident tets connected through non-cut
+//     faces, so every element keeps the copy of its side and a crack tip (partial cut) stays
+//     connected;
+//  5. hybrid: local optimisation (see Optimize3DOptions).
+#include <Eigen/Core>
+#include <vector>
+
+#include "hysim/cutting/cut2d.hpp"  // CutMethod, parseCutMethod, cutMethodName
+#include "hysim/cutting/cut_surface.hpp"
+#include "hysim/cutting/mesh.hpp"
+#include "hysim/cutting/result.hpp"
+#include "hysim/cutting/topology_change.hpp"
+
+namespace hysim::cutting {
+
+// Local regularisation after a hybrid cut: interior nodes up to `rings` edge steps from the
+// cut (not on the cut, not on the boundary) move under springs toward the local mean edge
+// length, heavily damped, until the largest move is below stop_fraction * mean edge length.
+// Each move is accepted only when no incident tet inverts and the worst incident q* does not
+// drop (so the local minimum quality never decreases).
+struct Optimize3DOptions {
+  bool enabled = true;
+  int rings = 2;
+  double step_gain = 0.3;
+  double stop_fraction = 0.02;
+  int max_iterations = 30;
+};
+
+struct Cut3DOptions {
+  CutMethod method = CutMethod::Hybrid;
+  // Hybrid: a crossing at a fraction t < snap_region of the edge from a node snaps that node.
+  // Snap uses 0.5 (always the nearer node); Standard and Delete never snap.
+  double snap_region = 0.35;
+  double feature_angle_deg = 20.0;  // boundary nodes move only where their boundary is flatter
+  double min_quality = 0.08;        // q* floor for snapping (see step 2), q* in [0, 1/3]
+  double min_edge_fraction = 0.3;   // a snapped node's edges keep >= this fraction of their length
+  double on_surface_tolerance = 1e-9;  // eps relative to the mesh bounding-box diagonal
+  bool separate = true;             // duplicate the nodes on the cut
+  Optimize3DOptions optimize;       // Hybrid only
+};
+
+struct Cut3DReport {
+  int crossed_edges = 0;      // before any snapping
+  int crossed_elements = 0;   // tets with nodes strictly on both sides
+  int snapped_nodes = 0;
+  int boundary_snaps = 0;     // of which moved within the boundary surface
+  int refused_snaps = 0;      // candidates refused by the quality/inversion guard
+  int split_edges = 0;        // new nodes on edges
+  int split_elements = 0;     // original tets subdivided
+  int deleted_elements = 0;
+  int duplicated_nodes = 0;
+  int cut_faces = 0;          // interior faces on the cut (now separated)
+  int optimized_nodes = 0;
+  int optimize_iterations = 0;
+  double cut_ms = 0, optimize_ms = 0;
+};
+
+struct Cut3DResult {
+  TetMesh mesh;
+  TopologyChange change;
+  Cut3DReport report;
+};
+
+// Cuts a valid, positively oriented tet mesh. Unchanged tets keep their index; a subdivided
+// tet's index is reused by one of its pieces (it is still listed as removed, and the piece
+// as added); new nodes are appended. Delete compacts both arrays.
+Result<Cut3DResult> cut3d(const TetMesh& mesh, const CutSurface& surface, const Cut3DOptions& options = {});
+
+// Connected components through shared faces (all three node indices equal).
+struct Components3D {
+  Eigen::VectorXi label;        // #T component of each tet, 0..count-1
+  int count = 0;
+  std::vector<double> volume;   // per component
+  std::vector<int> elements;    // per component
+  std::vector<bool> free;       // per component: touches no anchored node (a detached piece)
+};
+// `anchored`: node indices held fixed (may be empty: then every component is free).
+Components3D tetComponents(const TetMesh& mesh, const std::vector<int>& anchored = {});
+
+double totalVolume(const TetMesh& mesh);
+
+// Largest signed distance by which a tet has nodes strictly on both sides of a plane, as a
+// check: returns the number of tets with a node > eps and a node < -eps.
+int countStraddling(const TetMesh& mesh, const Eigen::Vector3d& point, const Eigen::Vector3d& normal, double eps);
+// Number of interior faces (shared by two tets) whose tets lie on opposite sides of the plane.
+int countFacesSharedAcross(const TetMesh& mesh, const Eigen::Vector3d& point, const Eigen::Vector3d& normal,
+                           double eps);
+
+}  // namespace hysim::cutting

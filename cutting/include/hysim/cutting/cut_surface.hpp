@@ -1,0 +1,81 @@
+#pragma once
+// Cut surfaces for 3D cutting: an infinite plane, or an open triangulated surface (the loop
+// electrode's swept strip) with an axis-aligned bounding-box tree for segment and
+// point queries. Eigen and the standard library only.
+//
+// Predicates (documented tolerance, not exact arithmetic): a point is ON the surface when its
+// distance to it is <= eps, where eps is given by the caller (cut3d uses
+// on_surface_tolerance * mesh bounding-box diagonal, default 1e-9 relative). A segment
+// CROSSES the surface only when both end points are farther than eps from the plane of the
+// hit triangle, on opposite sides, and the crossing point lies inside the triangle (inclusive
+// barycentric test with a 1e-12 relative slack, so a segment through a shared edge or vertex
+// of two surface triangles is found by at least one of them). End points within eps are
+// treated as lying on the surface and the segment as not crossed there; a segment lying in a
+// triangle's plane never crosses. This makes "through a node", "along an edge" and "in a face
+// plane" cuts well defined: those nodes are on the cut and nothing is subdivided there.
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <vector>
+
+#include "hysim/cutting/mesh.hpp"
+#include "hysim/cutting/result.hpp"
+
+namespace hysim::cutting {
+
+class CutSurface {
+ public:
+  // Plane through `point` with normal `normal` (normalised here; must be non-zero).
+  static Result<CutSurface> plane(const Eigen::Vector3d& point, const Eigen::Vector3d& normal);
+  // Open (or closed) triangle surface; degenerate triangles are dropped. Errors: no usable
+  // triangle, indices out of range, non-finite coordinates.
+  static Result<CutSurface> triangles(const Positions& X, const Tris& F);
+
+  bool isPlane() const { return is_plane_; }
+  const Eigen::Vector3d& planePoint() const { return point_; }
+  const Eigen::Vector3d& planeNormal() const { return normal_; }
+  int numTriangles() const { return static_cast<int>(tri_.size()); }
+
+  // Plane: signed distance. Surface: unsigned distance to the nearest triangle, with the sign
+  // of that triangle's normal side (only meaningful close to the surface).
+  // `closest` (optional) receives the nearest surface point.
+  double signedDistance(const Eigen::Vector3d& x, Eigen::Vector3d* closest = nullptr) const;
+
+  struct Hit {
+    double t = 0;                 // a + t (b - a), 0 < t < 1
+    Eigen::Vector3d point;
+    Eigen::Vector3d normal;       // unit normal of the hit triangle (plane normal)
+    double da = 0, db = 0;        // signed distances of a and b from the hit triangle's plane
+  };
+  // Crossing of the segment a-b (nearest to a when there are several). False when the
+  // segment does not cross (see the predicates above).
+  bool intersectSegment(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double eps, Hit* hit) const;
+
+  // The surface's bounding box (plane: empty box, i.e. unbounded).
+  const Eigen::AlignedBox3d& bounds() const { return bounds_; }
+  // Does the box (grown by eps) possibly touch the surface?
+  bool mayTouch(const Eigen::AlignedBox3d& box, double eps) const;
+
+ private:
+  struct Tri {
+    Eigen::Vector3d a, b, c, n;  // vertices, unit normal
+  };
+  struct Node {
+    Eigen::AlignedBox3d box;
+    int left = -1, right = -1;   // children; leaf when left < 0
+    int begin = 0, end = 0;      // leaf: range in order_
+  };
+  int build(int begin, int end);
+
+  bool is_plane_ = true;
+  Eigen::Vector3d point_ = Eigen::Vector3d::Zero(), normal_ = Eigen::Vector3d::UnitZ();
+  std::vector<Tri> tri_;
+  std::vector<int> order_;
+  std::vector<Node> nodes_;
+  Eigen::AlignedBox3d bounds_;
+};
+
+// Closest point of triangle (a, b, c) to p.
+Eigen::Vector3d closestPointOnTriangle(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
+                                       const Eigen::Vector3d& b, const Eigen::Vector3d& c);
+
+}  // namespace hysim::cutting

@@ -1,0 +1,206 @@
+#include "hysim/cutting/cut_surface.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+namespace hysim::cutting {
+
+Result<CutSurface> CutSurface::plane(const Eigen::Vector3d& point, const Eigen::Vector3d& normal) {
+  if (!point.allFinite() || !normal.allFinite()) return Error{"cut plane: non-finite point or normal"};
+  const double len = normal.norm();
+  if (!(len > 0)) return Error{"cut plane: zero normal"};
+  CutSurface s;
+  s.is_plane_ = true;
+  s.point_ = point;
+  s.normal_ = normal / len;
+  return s;
+}
+
+Result<CutSurface> CutSurface::triangles(const Positions& X, const Tris& F) {
+  CutSurface s;
+  s.is_plane_ = false;
+  for (Eigen::Index f = 0; f < F.rows(); ++f) {
+    for (int k = 0; k < 3; ++k)
+      if (F(f, k) < 0 || F(f, k) >= X.rows())
+        return Error{"cut surface: triangle " + std::to_string(f) + " has a node index out of range"};
+    Tri t;
+    t.a = X.row(F(f, 0)).transpose();
+    t.b = X.row(F(f, 1)).transpose();
+    t.c = X.row(F(f, 2)).transpose();
+    if (!t.a.allFinite() || !t.b.allFinite() || !t.c.allFinite())
+      return Error{"cut surface: triangle " + std::to_string(f) + " has non-finite coordinates"};
+    const Eigen::Vector3d n = (t.b - t.a).cross(t.c - t.a);
+    const double scale = std::max({(t.b - t.a).squaredNorm(), (t.c - t.a).squaredNorm(), (t.c - t.b).squaredNorm()});
+    if (!(n.norm() > 1e-12 * scale)) continue;  // degenerate
+    t.n = n.normalized();
+    s.tri_.push_back(t);
+  }
+  if (s.tri_.empty()) return Error{"cut surface: no non-degenerate triangle"};
+  s.order_.resize(s.tri_.size());
+  for (size_t i = 0; i < s.order_.size(); ++i) s.order_[i] = static_cast<int>(i);
+  s.nodes_.reserve(2 * s.tri_.size());
+  s.build(0, static_cast<int>(s.tri_.size()));
+  s.bounds_ = s.nodes_[0].box;
+  return s;
+}
+
+int CutSurface::build(int begin, int end) {
+  const int id = static_cast<int>(nodes_.size());
+  nodes_.emplace_back();
+  Eigen::AlignedBox3d box, centres;
+  for (int i = begin; i < end; ++i) {
+    const Tri& t = tri_[order_[i]];
+    box.extend(t.a).extend(t.b).extend(t.c);
+    centres.extend((t.a + t.b + t.c) / 3.0);
+  }
+  nodes_[id].box = box;
+  if (end - begin <= 4) {
+    nodes_[id].begin = begin;
+    nodes_[id].end = end;
+    return id;
+  }
+  int axis;
+  centres.sizes().maxCoeff(&axis);
+  const int mid = (begin + end) / 2;
+  std::nth_element(order_.begin() + begin, order_.begin() + mid, order_.begin() + end, [&](int x, int y) {
+    return tri_[x].a[axis] + tri_[x].b[axis] + tri_[x].c[axis] < tri_[y].a[axis] + tri_[y].b[axis] + tri_[y].c[axis];
+  });
+  const int left = build(begin, mid);
+  const int right = build(mid, end);
+  nodes_[id].left = left;
+  nodes_[id].right = right;
+  return id;
+}
+
+Eigen::Vector3d closestPointOnTriangle(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                                       const Eigen::Vector3d& c) {
+  // Voronoi-region walk (Ericson, Real-Time Collision Detection, 5.1.5).
+  const Eigen::Vector3d ab = b - a, ac = c - a, ap = p - a;
+  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0 && d2 <= 0) return a;
+  const Eigen::Vector3d bp = p - b;
+  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0 && d4 <= d3) return b;
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return a + (d1 / (d1 - d3)) * ab;
+  const Eigen::Vector3d cp = p - c;
+  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0 && d5 <= d6) return c;
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return a + (d2 / (d2 - d6)) * ac;
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) return b + ((d4 - d3) / ((d4 - d3) + (d5 - d6))) * (c - b);
+  const double denom = 1.0 / (va + vb + vc);
+  return a + ab * (vb * denom) + ac * (vc * denom);
+}
+
+double CutSurface::signedDistance(const Eigen::Vector3d& x, Eigen::Vector3d* closest) const {
+  if (is_plane_) {
+    const double d = normal_.dot(x - point_);
+    if (closest) *closest = x - d * normal_;
+    return d;
+  }
+  double best = std::numeric_limits<double>::infinity();
+  int bestTri = -1;
+  Eigen::Vector3d bestPoint = x;
+  int stack[128];
+  int top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const Node& node = nodes_[stack[--top]];
+    if (node.box.squaredExteriorDistance(x) >= best) continue;
+    if (node.left < 0) {
+      for (int i = node.begin; i < node.end; ++i) {
+        const Tri& t = tri_[order_[i]];
+        const Eigen::Vector3d q = closestPointOnTriangle(x, t.a, t.b, t.c);
+        const double d2 = (q - x).squaredNorm();
+        if (d2 < best) {
+          best = d2;
+          bestTri = order_[i];
+          bestPoint = q;
+        }
+      }
+    } else if (top + 2 <= 128) {
+      stack[top++] = node.left;
+      stack[top++] = node.right;
+    }
+  }
+  if (closest) *closest = bestPoint;
+  if (bestTri < 0) return std::numeric_limits<double>::infinity();
+  const double d = std::sqrt(best);
+  return tri_[bestTri].n.dot(x - tri_[bestTri].a) < 0 ? -d : d;
+}
+
+bool CutSurface::intersectSegment(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double eps, Hit* hit) const {
+  auto tryPlane = [&](const Eigen::Vector3d& n, const Eigen::Vector3d& p0, double* t, double* da, double* db) {
+    *da = n.dot(a - p0);
+    *db = n.dot(b - p0);
+    if (!((*da > eps && *db < -eps) || (*da < -eps && *db > eps))) return false;
+    *t = *da / (*da - *db);
+    return true;
+  };
+  if (is_plane_) {
+    double t, da, db;
+    if (!tryPlane(normal_, point_, &t, &da, &db)) return false;
+    hit->t = t;
+    hit->point = a + t * (b - a);
+    hit->normal = normal_;
+    hit->da = da;
+    hit->db = db;
+    return true;
+  }
+  Eigen::AlignedBox3d seg;
+  seg.extend(a).extend(b);
+  bool found = false;
+  double bestT = 2.0;
+  int stack[128];
+  int top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const Node& node = nodes_[stack[--top]];
+    if (!node.box.intersects(seg)) continue;
+    if (node.left < 0) {
+      for (int i = node.begin; i < node.end; ++i) {
+        const Tri& tr = tri_[order_[i]];
+        double t, da, db;
+        if (!tryPlane(tr.n, tr.a, &t, &da, &db) || t >= bestT) continue;
+        const Eigen::Vector3d p = a + t * (b - a);
+        // Inclusive inside test by signed sub-triangle areas along the normal.
+        const double area = tr.n.dot((tr.b - tr.a).cross(tr.c - tr.a));
+        const double slack = -1e-12 * area;
+        const double w0 = tr.n.dot((tr.b - p).cross(tr.c - p));
+        const double w1 = tr.n.dot((tr.c - p).cross(tr.a - p));
+        const double w2 = tr.n.dot((tr.a - p).cross(tr.b - p));
+        if (w0 < slack || w1 < slack || w2 < slack) continue;
+        found = true;
+        bestT = t;
+        hit->t = t;
+        hit->point = p;
+        hit->normal = tr.n;
+        hit->da = da;
+        hit->db = db;
+      }
+    } else if (top + 2 <= 128) {
+      stack[top++] = node.left;
+      stack[top++] = node.right;
+    }
+  }
+  return found;
+}
+
+bool CutSurface::mayTouch(const Eigen::AlignedBox3d& box, double eps) const {
+  if (is_plane_) {
+    // Support of the box along the normal.
+    const Eigen::Vector3d c = box.center(), h = 0.5 * box.sizes();
+    const double r = std::abs(normal_.x()) * h.x() + std::abs(normal_.y()) * h.y() + std::abs(normal_.z()) * h.z();
+    return std::abs(normal_.dot(c - point_)) <= r + eps;
+  }
+  Eigen::AlignedBox3d grown = box;
+  grown.min().array() -= eps;
+  grown.max().array() += eps;
+  return bounds_.intersects(grown);
+}
+
+}  // namespace hysim::cutting
