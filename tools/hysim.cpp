@@ -14,6 +14,7 @@
 #include "hysim/engine/scene.hpp"
 #include "hysim/engine/simulation.hpp"
 #include "hysim/render/renderer.hpp"
+#include "tool_common.hpp"
 #include "cli_cut2d.hpp"
 
 namespace fs = std::filesystem;
@@ -46,10 +47,6 @@ Status writeFileAtomically(const std::string& path, const std::string& text) {
   return Status::Ok();
 }
 
-std::string defaultScene() {
-  if (fs::exists("scenes/default.yaml")) return "scenes/default.yaml";
-  return std::string(HYSIM_SOURCE_DIR) + "/scenes/default.yaml";
-}
 
 struct RunArgs {
   std::string scene;
@@ -61,7 +58,7 @@ struct RunArgs {
 };
 
 int runCommand(const RunArgs& args) {
-  const std::string scene_path = args.scene.empty() ? defaultScene() : args.scene;
+  const std::string scene_path = args.scene.empty() ? tools::defaultScenePath() : args.scene;
   auto scene = engine::loadScene(scene_path);
   if (!scene.ok()) return fail(scene.error());
   auto sim = engine::Simulation::create(*scene);
@@ -120,19 +117,7 @@ int statsCommand(const std::string& path, bool json) {
     s = cutting::computeStats(*tris);
   }
   if (json) {
-    nlohmann::ordered_json j;
-    j["nodes"] = s.nodes;
-    j["elements"] = s.elements;
-    j["size_min"] = s.size_min;
-    j["size_mean"] = s.size_mean;
-    j["size_std"] = s.size_std;
-    j["edge_min"] = s.edge_min;
-    j["edge_mean"] = s.edge_mean;
-    j["edge_std"] = s.edge_std;
-    j["q_min"] = s.q_min;
-    j["q_mean"] = s.q_mean;
-    j["q_std"] = s.q_std;
-    j["dihedral_min_deg"] = s.dihedral_min_deg;
+    const nlohmann::ordered_json j = tools::statsJson(s);
     std::cout << j.dump(2) << "\n";
   } else {
     std::printf("%-8s %8s %10s %10s %10s %10s %8s %8s %8s %7s %7s %7s %9s\n", "", "#N", "#E", "size_min", "size_mu",

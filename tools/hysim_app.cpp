@@ -20,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "tool_common.hpp"
 #include "hysim/engine/scene.hpp"
 #include "hysim/engine/simulation.hpp"
 #include "hysim/render/image.hpp"
@@ -38,10 +39,6 @@ int fail(const std::string& message) {
   return 1;
 }
 
-std::string defaultScene() {
-  if (fs::exists("scenes/default.yaml")) return "scenes/default.yaml";
-  return std::string(HYSIM_SOURCE_DIR) + "/scenes/default.yaml";
-}
 
 double seconds(Clock::duration d) { return std::chrono::duration<double>(d).count(); }
 
@@ -127,7 +124,7 @@ int lensIndexFor(double deg) {
 }
 
 int runApp(const AppArgs& args) {
-  const std::string scene_path = args.scene.empty() ? defaultScene() : args.scene;
+  const std::string scene_path = args.scene.empty() ? tools::defaultScenePath() : args.scene;
   auto scene = engine::loadScene(scene_path);
   if (!scene.ok()) return fail(scene.error());
   auto created = engine::Simulation::create(*scene);
