@@ -144,11 +144,30 @@ Result<Model> buildModel(const TetMesh& mesh, const std::vector<Material>& mater
     if (!m.fixed[i]) m.inv_mass[i] = 1.0 / m.mass[i];
   }
   // A spring between two anchored nodes never changes length: the step skips it.
-  m.packed.clear();
-  m.packed.reserve(ns);
+  StepSprings& st = m.step_springs;
+  st = StepSprings{};
+  std::vector<int> degree(n, 0);
   for (int s = 0; s < ns; ++s) {
-    if (m.fixed[m.springs(s, 0)] && m.fixed[m.springs(s, 1)]) continue;
-    m.packed.push_back({m.springs(s, 0), m.springs(s, 1), m.rest_length[s], m.stiffness[s], m.damping[s]});
+    const int a = m.springs(s, 0), b = m.springs(s, 1);
+    if (m.fixed[a] && m.fixed[b]) continue;
+    st.a.push_back(a);
+    st.b.push_back(b);
+    st.rest_length.push_back(m.rest_length[s]);
+    st.stiffness.push_back(m.stiffness[s]);
+    st.damping.push_back(m.damping[s]);
+    ++degree[a];
+    ++degree[b];
+  }
+  st.node_offset.assign(n + 1, 0);
+  for (int i = 0; i < n; ++i) st.node_offset[i + 1] = st.node_offset[i] + degree[i];
+  st.incident.resize(st.node_offset[n]);
+  st.sign.resize(st.node_offset[n]);
+  std::vector<int> fill(st.node_offset.begin(), st.node_offset.end() - 1);
+  for (int k = 0; k < st.size(); ++k) {
+    st.incident[fill[st.a[k]]] = k;
+    st.sign[fill[st.a[k]]++] = 1.0;
+    st.incident[fill[st.b[k]]] = k;
+    st.sign[fill[st.b[k]]++] = -1.0;
   }
 
   // Stability of symplectic Euler with stiffness damping (zeta = beta*omega/2):
@@ -186,6 +205,7 @@ State makeState(const Model& model, const TetMesh& mesh) {
   s.scratch0 = NodeVectors::Zero(n, 3);
   s.scratch1 = NodeVectors::Zero(n, 3);
   s.scratch2 = NodeVectors::Zero(n, 3);
+  s.spring_force = Eigen::MatrixX3d::Zero(model.step_springs.size(), 3);
   s.solve0 = Eigen::MatrixX3d::Zero(n, 3);
   s.solve1 = Eigen::MatrixX3d::Zero(n, 3);
   return s;

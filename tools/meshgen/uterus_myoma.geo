@@ -23,7 +23,7 @@ myo_r = 8;                              // myoma radius
 // than the wall (150 vs 60 kPa, wave speed 1.55x), so it gets the larger elements; a
 // nearly uniform size everywhere else keeps short edges away and still gives ~12k tets.
 h_fine   = 2.7;   // target edge length at the cavity, canal and myoma surfaces
-h_myo    = 3.4;   // target edge length in a ball of radius myo_r + 1 around the myoma
+h_myo    = 2.8;   // target edge length in a ball of radius myo_r + 1 around the myoma
 h_coarse = 4.0;   // target edge length towards the outer surface
 d_fine   = 1.0;   // distance from the cavity/myoma surface where growth starts
 d_coarse = 14.0;  // distance where h_coarse would be reached (the wall is ~12 mm: ~3.8 mm at the outer surface)

@@ -37,6 +37,7 @@ struct ModelOptions {
   double drag_per_s = 0.0;                     // alpha: mass-proportional damping (fluid drag), 1/s
   Eigen::Vector3d gravity{0.0, 0.0, -9810.0};  // mm/s^2
   double max_speed_mm_s = 1e5;                 // a node faster than this is numerical trouble
+  bool simd = true;                            // AVX2 spring loop where the CPU has it (same results)
 };
 
 class ImplicitSolver;  // prefactored system of the implicit integrator (step.cpp)
@@ -45,11 +46,19 @@ class ImplicitSolver;  // prefactored system of the implicit integrator (step.cp
 // two cache lines per array instead of six (the step is bound by these gathers).
 using NodeVectors = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
 
-// One spring's data packed together for the step's inner loop (derived from the arrays
-// below by buildModel; the arrays stay the reference).
-struct PackedSpring {
-  std::int32_t a, b;
-  double rest_length, stiffness, damping;
+// The springs the explicit step evaluates (those with at least one free end), laid out for
+// it: structure-of-arrays so the force loop vectorises, and each node's incident springs in
+// compressed rows so forces are summed per node in a fixed order (no scatter, deterministic).
+// Derived from Model's spring arrays by buildModel; those arrays stay the reference.
+struct StepSprings {
+  std::vector<std::int32_t> a, b;      // #M node indices
+  std::vector<double> rest_length;     // #M, mm
+  std::vector<double> stiffness;       // #M, g/s^2
+  std::vector<double> damping;         // #M, g/s
+  std::vector<std::int32_t> node_offset;  // #N+1: node i's incident springs are entries [off[i], off[i+1])
+  std::vector<std::int32_t> incident;     // #2M spring index
+  std::vector<double> sign;               // #2M: +1 where the node is the spring's a end, -1 at b
+  int size() const { return static_cast<int>(a.size()); }
 };
 
 struct Model {
@@ -63,7 +72,7 @@ struct Model {
   Eigen::VectorXd stiffness;       // #S, g/s^2: Van Gelder k = sum_t E_t V_t / |e|^2
   Eigen::VectorXd damping;         // #S, g/s: c = beta * k
   std::vector<std::uint8_t> fixed; // #N, 1 = anchored (never moves)
-  std::vector<PackedSpring> packed; // <= #S: the springs above that can move (not both ends anchored)
+  StepSprings step_springs;          // the springs above that can move, for the explicit step
   std::vector<Material> materials;
 
   ModelOptions options;
@@ -82,6 +91,7 @@ struct State {
   NodeVectors scratch0; // #N x 3 integrator scratch (sized when the model is built)
   NodeVectors scratch1; // #N x 3
   NodeVectors scratch2; // #N x 3
+  Eigen::MatrixX3d spring_force;  // #M x 3 column-major: force of each step spring on its a end
   Eigen::MatrixX3d solve0;  // #N x 3 column-major: the sparse triangular solves work in place
   Eigen::MatrixX3d solve1;  // on column-major right-hand sides without temporaries
   std::uint64_t steps = 0;
