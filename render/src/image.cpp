@@ -21,6 +21,7 @@ hysim::Status writePng(const std::string& path, const Image& image) {
   png.width = static_cast<png_uint_32>(image.width);
   png.height = static_cast<png_uint_32>(image.height);
   png.format = PNG_FORMAT_RGBA;
+  png.flags = PNG_IMAGE_FLAG_FAST;  // frames are written every k steps: favour speed over size
   const int ok = png_image_write_to_file(&png, path.c_str(), 0, image.rgba.data(),
                                          image.width * 4, nullptr);
   if (!ok) {
