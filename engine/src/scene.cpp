@@ -176,8 +176,9 @@ void parseContact(const Reader& r, const YAML::Node& n, ContactSettings& c) {
   if (n["loop_drop_mm"]) c.loop_drop_mm = r.number(n["loop_drop_mm"], "loop_drop_mm");
 }
 
-haptics::Keyframe parseKeyframe(const Reader& r, const YAML::Node& n, double previous_time) {
-  r.checkKeys(n, "tool_path[]", {"t_s", "tip", "axis", "up", "extension_mm", "pedal"});
+haptics::Keyframe parseKeyframe(const Reader& r, const YAML::Node& n, const haptics::Keyframe* previous) {
+  r.checkKeys(n, "tool_path[]", {"t_s", "tip", "axis", "up", "extension_mm", "pedal", "move", "arc_center"});
+  const double previous_time = previous != nullptr ? previous->time_s : 0.0;
   haptics::Keyframe k;
   k.time_s = r.nonNegative(r.require(n, "t_s", "tool_path[]"), "t_s");
   if (k.time_s < previous_time) {
@@ -190,6 +191,22 @@ haptics::Keyframe parseKeyframe(const Reader& r, const YAML::Node& n, double pre
   if (std::abs(k.up.dot(k.axis)) > 0.999) r.fail(n["up"] ? n["up"] : n, "'up' must not be parallel to 'axis'");
   if (n["extension_mm"]) k.extension_mm = r.number(n["extension_mm"], "extension_mm");
   if (n["pedal"]) k.pedal = r.boolean(n["pedal"], "pedal");
+  if (n["move"]) {
+    const std::string move = r.string(n["move"], "move");
+    if (move == "linear") k.move = haptics::Keyframe::Move::Linear;
+    else if (move == "arc") k.move = haptics::Keyframe::Move::Arc;
+    else r.fail(n["move"], "'move' must be linear or arc, got '" + move + "'");
+  }
+  if (k.move == haptics::Keyframe::Move::Arc) {
+    k.arc_center = r.vec3(r.require(n, "arc_center", "tool_path[]"), "arc_center");
+    if (previous == nullptr) r.fail(n["move"], "the first keyframe cannot be an arc move");
+    if (!haptics::validArc(previous->tip, k.tip, k.arc_center)) {
+      r.fail(n["arc_center"], "arc from the previous tip to 'tip' about 'arc_center' is undefined "
+                              "(an end at the centre, or ends 0 or 180 degrees apart)");
+    }
+  } else if (n["arc_center"]) {
+    r.fail(n["arc_center"], "'arc_center' needs 'move: arc'");
+  }
   return k;
 }
 
@@ -231,10 +248,8 @@ Scene parse(const Reader& r, const YAML::Node& root, const std::string& path) {
 
   const YAML::Node tp = r.require(root, "tool_path", "scene");
   if (!tp.IsSequence() || tp.size() == 0) r.fail(tp, "'tool_path' must be a non-empty list of keyframes");
-  double previous = 0.0;
   for (const auto& k : tp) {
-    scene.tool_path.push_back(parseKeyframe(r, k, previous));
-    previous = scene.tool_path.back().time_s;
+    scene.tool_path.push_back(parseKeyframe(r, k, scene.tool_path.empty() ? nullptr : &scene.tool_path.back()));
   }
   if (root["camera"]) {
     const YAML::Node c = root["camera"];

@@ -81,8 +81,8 @@ Result<std::unique_ptr<Simulation>> Simulation::create(const Scene& scene) {
     for (int c = 0; c < 4; ++c) moves = moves || !s->model_.fixed[s->mesh_.T(t, c)];
     s->num_deformable_tets_ += moves ? 1 : 0;
   }
-  s->path_ = haptics::Trajectory(scene.tool_path);
-  s->pose_ = s->path_.sample(0.0);
+  s->device_ = std::make_unique<haptics::ScriptedDevice>(haptics::Trajectory(scene.tool_path));
+  s->pose_ = s->device_->read(0.0).pose;
 
   // Surface for contact and rendering: boundary faces, compacted vertex numbering.
   Eigen::VectorXi face_tet;
@@ -155,11 +155,12 @@ void Simulation::computeContact() {
 
 void Simulation::step() {
   // The pose for the end of this step drives the contact of this step.
-  pose_ = path_.sample(state_.time + scene_.sim.dt);
+  pose_ = device_->read(state_.time + scene_.sim.dt).pose;
   computeContact();
   sim::StepInput input;
   input.external_force = &contact_force_;
   sim::step(model_, state_, input);
+  device_->commandForce(tool_force_n_);  // clamped and NaN-guarded by the device
 }
 
 void Simulation::fillSnapshot(render::RenderSnapshot& snap) const {

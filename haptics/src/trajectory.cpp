@@ -21,6 +21,30 @@ Eigen::Matrix3d frameFromAxisUp(const Eigen::Vector3d& axis, const Eigen::Vector
   return r;
 }
 
+bool validArc(const Eigen::Vector3d& from, const Eigen::Vector3d& to, const Eigen::Vector3d& center) {
+  const Eigen::Vector3d r0 = from - center, r1 = to - center;
+  if (r0.norm() < 1e-9 || r1.norm() < 1e-9) return false;
+  const double sin_angle = r0.normalized().cross(r1.normalized()).norm();
+  const double cos_angle = r0.normalized().dot(r1.normalized());
+  return sin_angle > 1e-6 && cos_angle > -1.0 + 1e-9;
+}
+
+namespace {
+
+// Point at fraction s of the arc from `from` to `to` about `center`.
+Eigen::Vector3d arcPoint(const Eigen::Vector3d& from, const Eigen::Vector3d& to, const Eigen::Vector3d& center,
+                         double s) {
+  const Eigen::Vector3d r0 = from - center, r1 = to - center;
+  const Eigen::Vector3d axis = r0.cross(r1);
+  if (axis.norm() < 1e-12) return (1.0 - s) * from + s * to;  // degenerate: a line
+  const double angle = std::atan2(axis.norm(), r0.dot(r1));
+  const double radius = (1.0 - s) * r0.norm() + s * r1.norm();
+  const Eigen::Vector3d dir = Eigen::AngleAxisd(s * angle, axis.normalized()) * r0.normalized();
+  return center + radius * dir;
+}
+
+}  // namespace
+
 Trajectory::Trajectory(std::vector<Keyframe> keyframes) : keys_(std::move(keyframes)) {
   std::stable_sort(keys_.begin(), keys_.end(),
                    [](const Keyframe& a, const Keyframe& b) { return a.time_s < b.time_s; });
@@ -59,7 +83,7 @@ ToolPose Trajectory::sample(double t) const {
   const Keyframe& b = keys_[i1];
   const double span = b.time_s - a.time_s;
   const double s = span > 0.0 ? (t - a.time_s) / span : 1.0;
-  pose.tip = (1.0 - s) * a.tip + s * b.tip;
+  pose.tip = b.move == Keyframe::Move::Arc ? arcPoint(a.tip, b.tip, b.arc_center, s) : (1.0 - s) * a.tip + s * b.tip;
   pose.rotation = orientations_[i0].slerp(s, orientations_[i1]).toRotationMatrix();
   pose.extension_mm = (1.0 - s) * a.extension_mm + s * b.extension_mm;
   pose.pedal = a.pedal;

@@ -126,6 +126,23 @@ TEST(SceneErrors, TimeGoesBackwards) {
               "'t_s' must not be negative");
 }
 
+TEST(Scene, ArcMoveParses) {
+  auto scene = loadScene(writeFile("arc.yaml", minimalScene() +
+      "  - {t_s: 1, tip: [10, 2, -14], axis: [0, 0, 1], move: arc, arc_center: [0, 2, -14]}\n"));
+  ASSERT_TRUE(scene.ok()) << scene.error();
+  EXPECT_EQ(scene->tool_path[1].move, haptics::Keyframe::Move::Arc);
+}
+
+TEST(SceneErrors, ArcWithoutCentreOrUndefined) {
+  expectError("arc_nocenter.yaml", minimalScene() + "  - {t_s: 1, tip: [10, 2, -14], axis: [0, 0, 1], move: arc}\n",
+              ":11:", "missing required key 'arc_center'");
+  expectError("arc_180.yaml",
+              minimalScene() + "  - {t_s: 1, tip: [0, 2, -4], axis: [0, 0, 1], move: arc, arc_center: [0, 2, -14]}\n",
+              ":11:", "arc from the previous tip");
+  expectError("arc_move.yaml", minimalScene() + "  - {t_s: 1, tip: [0, 2, -4], axis: [0, 0, 1], move: spiral}\n",
+              ":11:", "'move' must be linear or arc, got 'spiral'");
+}
+
 TEST(SceneErrors, EmptyFileAndMissingFile) {
   expectError("empty.yaml", "", ":", "empty");
   auto scene = loadScene("/nonexistent/scene.yaml");

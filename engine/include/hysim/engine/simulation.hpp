@@ -8,7 +8,7 @@
 
 #include "hysim/cutting/mesh.hpp"
 #include "hysim/engine/scene.hpp"
-#include "hysim/haptics/trajectory.hpp"
+#include "hysim/haptics/device.hpp"
 #include "hysim/render/snapshot.hpp"
 #include "hysim/sim/model.hpp"
 
@@ -30,6 +30,7 @@ class Simulation {
   const sim::Model& model() const { return model_; }
   const sim::State& state() const { return state_; }
   const haptics::ToolPose& toolPose() const { return pose_; }
+  const haptics::Device& device() const { return *device_; }
   int numAnchored() const { return num_anchored_; }
   int numDeformableTets() const { return num_deformable_tets_; }  // tets with at least one free node
   int numSurfaceNodes() const { return static_cast<int>(surface_nodes_.size()); }
@@ -48,7 +49,7 @@ class Simulation {
   cutting::TetMesh mesh_;
   sim::Model model_;
   sim::State state_;
-  haptics::Trajectory path_;
+  std::unique_ptr<haptics::Device> device_;  // the scene's scripted device (hardware later)
   haptics::ToolPose pose_;
 
   cutting::Tris surface_faces_;                   // #B x 3 boundary faces, model node ids
