@@ -12,6 +12,7 @@
 #include "hysim/cutting/mesh_io.hpp"
 #include "hysim/cutting/mesh_stats.hpp"
 #include "tables.hpp"
+#include "cli_cut3d.hpp"
 
 namespace hysim::tools {
 
@@ -19,6 +20,7 @@ struct Cut2dCommands {
   CLI::App* cut = nullptr;
   CLI::App* tables = nullptr;
   std::string in, out, line, method = "hybrid", stats;
+  std::string plane, surface;  // 3D cuts (cli_cut3d.cpp)
   int table = 0;
   Table1Options table1;
 };
@@ -27,7 +29,9 @@ std::shared_ptr<Cut2dCommands> addCut2dCommands(CLI::App& app) {
   auto c = std::make_shared<Cut2dCommands>();
   c->cut = app.add_subcommand("cut", "Cut a planar triangle mesh along a segment (2D hybrid cutting and baselines)");
   c->cut->add_option("mesh", c->in, "Input mesh (.msh or .vtk, planar triangles)")->required()->check(CLI::ExistingFile);
-  c->cut->add_option("--line", c->line, "The cut segment x0,y0,x1,y1 (mm)")->required();
+  c->cut->add_option("--line", c->line, "The cut segment x0,y0,x1,y1 (mm)");
+  c->cut->add_option("--plane", c->plane, "Tet meshes: the cut plane px,py,pz,nx,ny,nz (mm)");
+  c->cut->add_option("--surface", c->surface, "Tet meshes: an open cut surface (OBJ/STL/PLY, or .msh triangles)");
   c->cut->add_option("--method", c->method, "hybrid | standard | snap | delete (default hybrid)");
   c->cut->add_option("--out", c->out, "Output mesh (.msh or .vtk)")->required();
   c->cut->add_option("--stats", c->stats, "Write the output's statistics (hysim stats --json keys + time_ms) here");
@@ -107,9 +111,19 @@ int cutCommand(const Cut2dCommands& c) {
 }  // namespace
 
 std::optional<int> runCut2dCommands(const Cut2dCommands& c) {
-  if (c.cut && *c.cut) return cutCommand(c);
+  if (c.cut && *c.cut) {
+    if (!c.plane.empty() || !c.surface.empty())
+      return runCut3d(Cut3dArgs{c.in, c.out, c.plane, c.surface, c.method, c.stats});
+    if (c.line.empty()) return fail("cut: give --line (triangle meshes) or --plane / --surface (tet meshes)");
+    return cutCommand(c);
+  }
   if (c.tables && *c.tables) {
-    if (c.table != 1) return fail("--table: only table 1 is implemented here");
+    if (c.table == 2) {
+      Table2Options t2;
+      t2.json_path = c.table1.json_path;
+      return runTable2(t2);
+    }
+    if (c.table != 1) return fail("--table: only tables 1 and 2 are implemented");
     return runTable1(c.table1);
   }
   return std::nullopt;

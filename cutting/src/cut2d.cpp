@@ -298,6 +298,44 @@ void displaceNodes(Work& w, const Polyline& pl, const std::vector<std::vector<Ev
   }
 }
 
+// Hybrid: where the cut enters or leaves the mesh through a border edge close to a feature
+// node (a corner, which must not move), the cut is bent to pass through that node: within
+// the first element it runs from the corner to the original line instead of cutting off a
+// sliver of the corner that no element of the mesh's size could represent well. Returns
+// true when the polyline changed.
+bool bendToCorners(const Work& w, Polyline& pl, const std::vector<std::vector<Event>>& chains, const BorderInfo& bi,
+                   double region, double h) {
+  if (chains.empty() || region <= 0) return false;
+  const int nseg = static_cast<int>(pl.pts.size()) - 1;
+  auto corner = [&](const Event& e) {
+    if (e.vertex || !w.isBorderEdge(e.a, e.b)) return -1;
+    const int n = e.t < 0.5 ? e.a : e.b;
+    return bi.corner[n] && std::min(e.t, 1 - e.t) < region ? n : -1;
+  };
+  const Event first = chains.front().front(), last = chains.back().back();
+  const int c0 = corner(first), c1 = corner(last);
+  if (c0 < 0 && c1 < 0) return false;
+  std::vector<Vec2> pts = pl.pts;
+  if (c1 >= 0) {
+    const int i = std::clamp(static_cast<int>(std::floor(last.s)), 0, nseg - 1);
+    const Vec2 d = (pts[i + 1] - pts[i]).normalized();
+    const Vec2 y = last.p - std::min(h, 0.5 * (last.p - pts[i]).norm()) * d;
+    pts.resize(i + 1);
+    pts.push_back(y);
+    pts.push_back(w.nodes[c1].p);
+  }
+  if (c0 >= 0) {
+    const int i = std::clamp(static_cast<int>(std::floor(first.s)), 0, nseg - 1);
+    const Vec2 d = (pts[i + 1] - pts[i]).normalized();
+    const Vec2 y = first.p + std::min(h, 0.5 * (pts[i + 1] - first.p).norm()) * d;
+    std::vector<Vec2> head{w.nodes[c0].p, y};
+    pts.erase(pts.begin(), pts.begin() + i + 1);
+    pts.insert(pts.begin(), head.begin(), head.end());
+  }
+  pl.pts = pts;
+  return true;
+}
+
 // Hybrid look-ahead (step 3): vertex a -> edge (x, y) -> vertex d, i.e. two type-2 cases
 // in a row, becomes one edge flip (x, y) -> (a, d) when both new elements are good enough.
 // Otherwise the two triangles are subdivided later (two new elements).
@@ -642,6 +680,8 @@ Result<Cut2DResult> cut2d(const TriMesh& mesh, const std::vector<Eigen::Vector2d
   }
   const double eps = 1e-9 * meanEdge;
   Polyline pl{polyline};
+  int usedNodes = 0;  // the node budget of the optimisation
+  for (const auto& l : w.nodeTris) usedNodes += !l.empty();
 
   Cut2DResult result;
   Cut2DReport& rep = result.report;
@@ -656,6 +696,8 @@ Result<Cut2DResult> cut2d(const TriMesh& mesh, const std::vector<Eigen::Vector2d
     if (options.method == CutMethod::Hybrid || options.method == CutMethod::Snap) {
       const bool hybrid = options.method == CutMethod::Hybrid;
       const BorderInfo bi = borderInfo(w, options.feature_angle_deg);
+      if (hybrid && bendToCorners(w, pl, chains, bi, options.corner_region, meanEdge))
+        chains = eventChains(w, computeEvents(w, pl, eps));
       // Snapping only: every crossing displaces its nearer node; only folding or
       // flattening (q < 0.01) refuses.
       displaceNodes(w, pl, chains, hybrid ? options.snap_region : 0.5001, hybrid ? options.min_quality : 0.01, bi,
@@ -667,7 +709,7 @@ Result<Cut2DResult> cut2d(const TriMesh& mesh, const std::vector<Eigen::Vector2d
     rep.cut_ms = msSince(t0);
     if (options.method == CutMethod::Hybrid && options.optimize.enabled) {
       const auto t1 = Clock::now();
-      detail::optimizeAfterCut(w, nodeChains, meanEdge, options, rep);
+      detail::optimizeAfterCut(w, nodeChains, meanEdge, options.optimize.keep_node_count ? usedNodes : -1, options, rep);
       rep.optimize_ms = msSince(t1);
     }
     if (options.separate) separate(w, nodeChains, rep);

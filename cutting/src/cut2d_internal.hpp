@@ -140,8 +140,9 @@ using Chains = std::vector<std::vector<int>>;
 
 // Mesh optimisation after the cut (optimize2d.cpp): edge collapse on the cut, equal node
 // distribution along the cut, local mass-spring / particle regularisation. Chains are
-// updated (collapsed nodes removed). `mean_edge` is the initial mesh's mean edge length.
-void optimizeAfterCut(Work& w, Chains& chains, double mean_edge, const Cut2DOptions& options,
+// updated (collapsed nodes removed). `mean_edge` is the initial mesh's mean edge length;
+// `target_nodes` the node count to come back to by collapses near the cut (-1: none).
+void optimizeAfterCut(Work& w, Chains& chains, double mean_edge, int target_nodes, const Cut2DOptions& options,
                       Cut2DReport& report);
 
 }  // namespace hysim::cutting::detail

@@ -266,13 +266,323 @@ void regularise(Work& w, const Chains& chains, double meanEdge, const Cut2DOptio
   rep.regularisation_iterations = it;
 }
 
+
+// ---------------------------------------------------------------------------------------
+// Quality repair (beyond the paper's Fig. 1, within its "mesh optimisation"): local
+// topology and position operations driven by the worst elements near the cut.
+//   - edge flips that raise the smaller quality of the two triangles (never a cut or border
+//     edge, never a fold);
+//   - node optimisation: a node moves (pattern search) to raise the worst quality of its
+//     triangles; interior nodes move freely, cut nodes slide along the cut (before the
+//     sides are separated, so both copies move together), border nodes slide along straight
+//     border stretches only; chain ends, corners and curved-border nodes stay;
+//   - node budget: edge collapses near the cut remove the nodes the cut added, so that the
+//     node (and element) count stays that of the input.
+
+struct RepairContext {
+  std::vector<char> onCut;        // per node: on a chain
+  std::vector<char> chainEnd;     // per node: first or last node of a chain
+  std::vector<Vec2> slide;        // per node: unit direction it may move along (0: free)
+  std::vector<signed char> kind;  // -1 unknown, 0 fixed, 1 free, 2 slides along `slide`
+};
+
+// How node n may move: fixed, free, or along a line.
+int nodeKind(Work& w, const Chains& chains, RepairContext& rc, int n) {
+  if (rc.kind[n] >= 0) return rc.kind[n];
+  int k = 1;
+  if (rc.chainEnd[n]) {
+    k = 0;
+  } else if (rc.onCut[n]) {
+    k = 0;
+    for (const auto& ch : chains)
+      for (std::size_t i = 1; i + 1 < ch.size(); ++i)
+        if (ch[i] == n && !w.isBorderNode(n)) {
+          const Vec2 d = w.nodes[ch[i + 1]].p - w.nodes[ch[i - 1]].p;
+          if (d.norm() > 0) {
+            rc.slide[n] = d.normalized();
+            k = 2;
+          }
+        }
+  } else if (w.isBorderNode(n)) {
+    k = 0;
+    std::vector<int> nb, bn;
+    w.neighbours(n, nb);
+    for (int x : nb)
+      if (w.isBorderEdge(n, x)) bn.push_back(x);
+    if (bn.size() == 2) {
+      const Vec2 d0 = w.nodes[n].p - w.nodes[bn[0]].p, d1 = w.nodes[bn[1]].p - w.nodes[n].p;
+      if (std::abs(cross2(d0, d1)) <= 1e-12 * d0.norm() * d1.norm() && d0.dot(d1) > 0) {
+        rc.slide[n] = d0.normalized();
+        k = 2;
+      }
+    }
+  }
+  rc.kind[n] = static_cast<signed char>(k);
+  return k;
+}
+
+// Pattern search on the worst quality around n. Returns true when n moved.
+bool optimiseNode(Work& w, int n, int kind, const Vec2& dir, double h) {
+  if (kind == 0 || w.nodeTris[n].empty()) return false;
+  static const double c = std::sqrt(0.5);
+  static const Vec2 dirs8[8] = {Vec2(1, 0), Vec2(-1, 0), Vec2(0, 1), Vec2(0, -1),
+                                Vec2(c, c), Vec2(-c, -c), Vec2(c, -c), Vec2(-c, c)};
+  double best = w.minQualityAround(n);
+  Vec2 p = w.nodes[n].p;
+  const Vec2 start = p;
+  // First try the centroid of the neighbours (Laplacian), the usual good guess.
+  if (kind == 1) {
+    std::vector<int> nb;
+    w.neighbours(n, nb);
+    Vec2 cen = Vec2::Zero();
+    for (int x : nb) cen += w.nodes[x].p;
+    cen /= static_cast<double>(nb.size());
+    const double q = w.minQualityIfMoved(n, cen);
+    if (q > best) {
+      best = q;
+      p = cen;
+    }
+  }
+  double s = 0.2 * h;
+  for (int it = 0; it < 24 && s > 0.004 * h; ++it) {
+    Vec2 bp = p;
+    double bq = best;
+    const int nd = kind == 1 ? 8 : 2;
+    for (int k = 0; k < nd; ++k) {
+      const Vec2 d = kind == 1 ? dirs8[k] : (k == 0 ? dir : Vec2(-dir));
+      const Vec2 cand = p + s * d;
+      const double q = w.minQualityIfMoved(n, cand);
+      if (q > bq + 1e-9) {
+        bq = q;
+        bp = cand;
+      }
+    }
+    if (bq > best) {
+      best = bq;
+      p = bp;
+    } else {
+      s *= 0.5;
+    }
+  }
+  if (p == start) return false;
+  w.nodes[n].p = p;
+  return true;
+}
+
+// Flips edge (x, y) when that raises the smaller quality of its two triangles.
+bool tryFlip(Work& w, const RepairContext& rc, int x, int y) {
+  if (rc.onCut[x] && rc.onCut[y]) return false;
+  int tt[2];
+  if (w.edgeTris(x, y, tt) != 2) return false;
+  // t1 = (x, y, a), t2 = (y, x, d), counter-clockwise.
+  auto rot = [&](int t, int first) {
+    auto v = w.tris[t].v;
+    while (v[0] != first) std::rotate(v.begin(), v.begin() + 1, v.end());
+    return v;
+  };
+  auto v1 = rot(tt[0], x);
+  int t1 = tt[0], t2 = tt[1];
+  if (v1[1] != y) {
+    std::swap(t1, t2);
+    v1 = rot(t1, x);
+  }
+  const auto v2 = rot(t2, y);
+  if (v1[1] != y || v2[1] != x) return false;
+  const int a = v1[2], d = v2[2];
+  if (a == d) return false;
+  // The new edge must not exist already.
+  for (int t : w.nodeTris[a])
+    if (contains(w.tris[t].v, d)) return false;
+  const Vec2 &px = w.nodes[x].p, &py = w.nodes[y].p, &pa = w.nodes[a].p, &pd = w.nodes[d].p;
+  const double before = std::min(triQuality(px, py, pa), triQuality(py, px, pd));
+  const double after = std::min(triQuality(px, pd, pa), triQuality(py, pa, pd));
+  if (after <= before + 1e-9) return false;
+  const int m1 = w.tris[t1].material, m2 = w.tris[t2].material;
+  w.killTri(t1);
+  w.killTri(t2);
+  w.addTri(x, d, a, m1);
+  w.addTri(y, a, d, m2);
+  return true;
+}
+
+void bandNodes(const Work& w, const Chains& chains, int rings, std::vector<int>& out) {
+  out.clear();
+  static thread_local std::vector<char> seen;
+  seen.assign(w.nodes.size(), 0);
+  std::vector<int> frontier, next, nb;
+  for (const auto& ch : chains)
+    for (int n : ch)
+      if (!seen[n]) {
+        seen[n] = 1;
+        out.push_back(n);
+        frontier.push_back(n);
+      }
+  for (int r = 1; r <= rings; ++r) {
+    next.clear();
+    for (int n : frontier) {
+      w.neighbours(n, nb);
+      for (int x : nb)
+        if (!seen[x]) {
+          seen[x] = 1;
+          out.push_back(x);
+          next.push_back(x);
+        }
+    }
+    frontier.swap(next);
+  }
+}
+
+void repair(Work& w, Chains& chains, double h, const Cut2DOptions& o, Cut2DReport& rep) {
+  const double target = o.optimize.repair_quality;
+  RepairContext rc;
+  const std::size_t N = w.nodes.size();
+  rc.onCut.assign(N, 0);
+  rc.chainEnd.assign(N, 0);
+  rc.slide.assign(N, Vec2::Zero());
+  rc.kind.assign(N, -1);
+  for (const auto& ch : chains) {
+    for (int n : ch) rc.onCut[n] = 1;
+    if (!ch.empty()) rc.chainEnd[ch.front()] = rc.chainEnd[ch.back()] = 1;
+  }
+  std::vector<int> band, tris, nb, bad;
+  bandNodes(w, chains, o.optimize.rings + 1, band);
+  std::vector<int> triStamp, nodeStamp(N, -1);
+  for (int round = 0; round < o.optimize.repair_rounds; ++round) {
+    // Triangles of the band below the target quality.
+    triStamp.assign(w.tris.size(), 0);
+    bad.clear();
+    for (int n : band)
+      for (int t : w.nodeTris[n]) {
+        if (triStamp[t]) continue;
+        triStamp[t] = 1;
+        const auto& v = w.tris[t].v;
+        if (triQuality(w.nodes[v[0]].p, w.nodes[v[1]].p, w.nodes[v[2]].p) < target) bad.push_back(t);
+      }
+    if (bad.empty()) break;
+    bool changed = false;
+    for (int t : bad) {
+      if (!w.tris[t].alive) continue;
+      const auto v = w.tris[t].v;
+      for (int k = 0; k < 3 && w.tris[t].alive; ++k)
+        if (tryFlip(w, rc, v[k], v[(k + 1) % 3])) {
+          ++rep.repair_flips;
+          changed = true;
+        }
+    }
+    // Each node of a bad triangle and its neighbours (a triangle whose corners cannot move
+    // improves when its neighbours make room), once per round, worst triangles first.
+    auto visit = [&](int n) {
+      if (nodeStamp[n] == round) return;
+      nodeStamp[n] = round;
+      if (optimiseNode(w, n, nodeKind(w, chains, rc, n), rc.slide[n], h)) {
+        ++rep.repair_moves;
+        changed = true;
+      }
+    };
+    for (int t : bad) {
+      if (!w.tris[t].alive) continue;
+      const auto v = w.tris[t].v;
+      for (int k = 0; k < 3; ++k) visit(v[k]);
+    }
+    for (int t : bad) {
+      if (!w.tris[t].alive) continue;
+      const auto v = w.tris[t].v;
+      if (triQuality(w.nodes[v[0]].p, w.nodes[v[1]].p, w.nodes[v[2]].p) >= target) continue;
+      for (int k = 0; k < 3; ++k) {
+        w.neighbours(v[k], nb);
+        for (int x : nb) visit(x);
+      }
+    }
+    if (!changed) break;
+  }
+}
+
+// Smallest quality of the triangles around r if r were merged into s (the triangles on edge
+// (r, s) disappear); -1 when the link condition fails (the result would not be manifold).
+// `nr` holds the neighbours of r.
+double collapseQuality(const Work& w, int r, int s, const std::vector<int>& nr, std::vector<int>& ns) {
+  w.neighbours(s, ns);
+  int third = 0;
+  for (int t : w.nodeTris[r]) third += contains(w.tris[t].v, s);
+  if (third == 0) return -1;
+  int common = 0;
+  for (int x : nr)
+    if (x != s && std::find(ns.begin(), ns.end(), x) != ns.end()) ++common;
+  if (common != third) return -1;
+  const Vec2 ps = w.nodes[s].p;
+  double q = 1.0;
+  for (int t : w.nodeTris[r]) {
+    const auto& v = w.tris[t].v;
+    if (contains(v, s)) continue;
+    Vec2 c[3];
+    for (int k = 0; k < 3; ++k) c[k] = v[k] == r ? ps : w.nodes[v[k]].p;
+    q = std::min(q, triQuality(c[0], c[1], c[2]));
+  }
+  return q;
+}
+
+// Node budget: while the mesh has more (alive, used) nodes than `target`, merges the node
+// near the cut whose removal leaves the best worst element (nodes made by this cut first).
+void collapseToBudget(Work& w, Chains& chains, int target, double h, const Cut2DOptions& o, Cut2DReport& rep) {
+  int count = 0;
+  for (std::size_t i = 0; i < w.nodes.size(); ++i) count += w.nodes[i].alive && !w.nodeTris[i].empty();
+  std::vector<int> band, nr, ns;
+  std::vector<int> prev(w.nodes.size(), -1), next(w.nodes.size(), -1);
+  std::vector<char> chainEnd(w.nodes.size(), 0);
+  for (int guard = 0; count > target && guard < 64; ++guard) {
+    // Candidates: the cut's nodes and their neighbours.
+    bandNodes(w, chains, 1, band);
+    std::fill(prev.begin(), prev.end(), -1);
+    std::fill(next.begin(), next.end(), -1);
+    std::fill(chainEnd.begin(), chainEnd.end(), 0);
+    for (const auto& ch : chains) {
+      for (std::size_t i = 0; i + 1 < ch.size(); ++i) {
+        next[ch[i]] = ch[i + 1];
+        prev[ch[i + 1]] = ch[i];
+      }
+      if (!ch.empty()) chainEnd[ch.front()] = chainEnd[ch.back()] = 1;
+    }
+    double bestScore = -1e300;
+    int br = -1, bs = -1;
+    for (int r : band) {
+      if (chainEnd[r] || w.isBorderNode(r)) continue;
+      const bool cutNode = prev[r] >= 0 || next[r] >= 0;
+      w.neighbours(r, nr);
+      for (int s : nr) {
+        // A cut node merges only into its neighbour along the cut.
+        if (cutNode && s != prev[r] && s != next[r]) continue;
+        const double q = collapseQuality(w, r, s, nr, ns);
+        if (q < o.optimize.collapse_quality) continue;
+        const double len = (w.nodes[r].p - w.nodes[s].p).norm();
+        // Prefer good results, short edges and nodes this cut made.
+        const double score = q - 0.2 * len / h + (w.nodes[r].old < 0 ? 0.1 : 0.0);
+        if (score > bestScore) {
+          bestScore = score;
+          br = r;
+          bs = s;
+        }
+      }
+    }
+    if (br < 0 || !tryCollapse(w, br, bs, -1.0)) break;
+    for (auto& ch : chains) {
+      auto it = std::find(ch.begin(), ch.end(), br);
+      if (it != ch.end()) ch.erase(it);
+    }
+    ++rep.collapsed_edges;
+    --count;
+  }
+}
+
 }  // namespace
 
-void optimizeAfterCut(Work& w, Chains& chains, double meanEdge, const Cut2DOptions& options, Cut2DReport& report) {
+void optimizeAfterCut(Work& w, Chains& chains, double meanEdge, int targetNodes, const Cut2DOptions& options,
+                      Cut2DReport& report) {
   for (auto& ch : chains) collapseOnCut(w, ch, meanEdge, options, report);
   if (options.optimize.distribute)
     for (const auto& ch : chains) distributeOnCut(w, ch, options.min_quality);
+  if (targetNodes >= 0) collapseToBudget(w, chains, targetNodes, meanEdge, options, report);
   if (options.optimize.rings > 0) regularise(w, chains, meanEdge, options, report);
+  if (options.optimize.repair_rounds > 0) repair(w, chains, meanEdge, options, report);
 }
 
 }  // namespace hysim::cutting::detail

@@ -39,6 +39,14 @@ struct Optimize2DOptions {
   // A regularisation move is refused when it would leave the worst element around the node
   // below min(its quality before the move, quality_guard).
   double quality_guard = 0.35;
+  // Quality repair after the regularisation (beyond the paper): triangles near the cut
+  // below this quality get edge flips and node optimisation (see optimize2d.cpp).
+  double repair_quality = 0.35;
+  int repair_rounds = 6;
+  // Node budget (beyond the paper): nodes near the cut are merged until the node count is
+  // back to the input's, when the merge leaves no element below this quality.
+  bool keep_node_count = true;
+  double collapse_quality = 0.15;
 };
 
 struct Cut2DOptions {
@@ -49,6 +57,10 @@ struct Cut2DOptions {
   // Border nodes move only along the border, and not at a feature: where the normals of
   // the two border edges differ by more than this angle.
   double feature_angle_deg = 20.0;
+  // Hybrid: a cut entering or leaving through a border edge within this fraction of the
+  // edge from a feature node is bent to pass through that node (beyond the paper; a sliver
+  // cut off a corner cannot be meshed with elements of the mesh's size). 0 disables.
+  double corner_region = 0.4;
   // A displacement (or flip) is refused, falling back to subdivision, when an element would
   // get a radius ratio below this (folded and flat elements always refuse).
   double min_quality = 0.12;
@@ -66,6 +78,8 @@ struct Cut2DReport {
   int collapsed_edges = 0;     // optimisation: edge collapses on the cut
   int regularised_nodes = 0;   // optimisation: movable nodes
   int regularisation_iterations = 0;
+  int repair_flips = 0;         // optimisation: quality-driven edge flips
+  int repair_moves = 0;         // optimisation: quality-driven node moves
   int deleted_elements = 0;
   int duplicated_nodes = 0;
   double cut_ms = 0.0;         // everything but the optimisation

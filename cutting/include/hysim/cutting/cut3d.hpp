@@ -36,21 +36,24 @@ namespace hysim::cutting {
 // cut (not on the cut, not on the boundary) move under springs toward the local mean edge
 // length, heavily damped, until the largest move is below stop_fraction * mean edge length.
 // Each move is accepted only when no incident tet inverts and the worst incident q* does not
-// drop (so the local minimum quality never decreases).
+// drop (so the local minimum quality never decreases). Edge collapse on the cut is not done.
 struct Optimize3DOptions {
   bool enabled = true;
   int rings = 2;
   double step_gain = 0.3;
   double stop_fraction = 0.02;
-  int max_iterations = 30;
+  int max_iterations = 8;
+  // Only nodes whose worst incident q* is below this move (good neighbourhoods are left
+  // alone, which keeps the step within the time budget).
+  double quality_target = 0.12;
 };
 
 struct Cut3DOptions {
   CutMethod method = CutMethod::Hybrid;
   // Hybrid: a crossing at a fraction t < snap_region of the edge from a node snaps that node.
   // Snap uses 0.5 (always the nearer node); Standard and Delete never snap.
-  double snap_region = 0.35;
-  double feature_angle_deg = 20.0;  // boundary nodes move only where their boundary is flatter
+  double snap_region = 0.45;
+  double feature_angle_deg = 30.0;  // boundary nodes move only where their boundary is flatter
   double min_quality = 0.08;        // q* floor for snapping (see step 2), q* in [0, 1/3]
   double min_edge_fraction = 0.3;   // a snapped node's edges keep >= this fraction of their length
   double on_surface_tolerance = 1e-9;  // eps relative to the mesh bounding-box diagonal
@@ -64,6 +67,7 @@ struct Cut3DReport {
   int snapped_nodes = 0;
   int boundary_snaps = 0;     // of which moved within the boundary surface
   int refused_snaps = 0;      // candidates refused by the quality/inversion guard
+  int feature_skips = 0;      // boundary candidates not moved: at a feature, or cut ~parallel
   int split_edges = 0;        // new nodes on edges
   int split_elements = 0;     // original tets subdivided
   int deleted_elements = 0;

@@ -36,6 +36,9 @@ struct TopologyChange {
   std::vector<std::int32_t> cut_nodes;          // new indices of the nodes on the cut (both sides)
   // Node pairs (new indices) of the edges the cut runs along, one entry per side.
   std::vector<std::array<std::int32_t, 2>> cut_edges;
+  // 3D cuts: the triangles on the cut (new indices), one entry per side, each oriented
+  // outward from the tet it belongs to (for rendering the wound surface).
+  std::vector<std::array<std::int32_t, 3>> cut_faces;
 };
 
 }  // namespace hysim::cutting
