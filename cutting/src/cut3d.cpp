@@ -1,0 +1,752 @@
+// Hybrid cutting of tetrahedral meshes (see cut3d.hpp for the outline).
+#include "hysim/cutting/cut3d.hpp"
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <numeric>
+#include <string>
+#include <unordered_map>
+#include <unordered_set>
+
+#include "hysim/cutting/mesh_stats.hpp"
+
+namespace hysim::cutting {
+
+void optimizeAfterCut3D(TetMesh& mesh, const std::vector<std::int32_t>& cut_nodes, const Optimize3DOptions& options,
+                        std::vector<std::int32_t>* moved, int* iterations);  // optimize3d.cpp
+
+namespace {
+
+using Vec3 = Eigen::Vector3d;
+using Tet = std::array<std::int32_t, 4>;
+
+std::uint64_t edgeKey(std::int32_t a, std::int32_t b) {
+  if (a > b) std::swap(a, b);
+  return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(a)) << 32) | static_cast<std::uint32_t>(b);
+}
+
+struct FaceKey {
+  std::array<std::int32_t, 3> v;
+  bool operator==(const FaceKey& o) const { return v[0] == o.v[0] && v[1] == o.v[1] && v[2] == o.v[2]; }
+  bool operator<(const FaceKey& o) const {
+    return v[0] != o.v[0] ? v[0] < o.v[0] : v[1] != o.v[1] ? v[1] < o.v[1] : v[2] < o.v[2];
+  }
+};
+struct FaceKeyHash {
+  size_t operator()(const FaceKey& k) const {
+    std::uint64_t h = 1469598103934665603ull;
+    for (int x : k.v) h = (h ^ static_cast<std::uint32_t>(x)) * 1099511628211ull;
+    return static_cast<size_t>(h);
+  }
+};
+FaceKey makeFace(std::int32_t a, std::int32_t b, std::int32_t c) {
+  FaceKey k{{a, b, c}};
+  std::sort(k.v.begin(), k.v.end());
+  return k;
+}
+
+// Outward faces of a positive tet, by the local index of the opposite vertex.
+constexpr int kFace[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
+constexpr int kEdge[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
+
+double signedVolume(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
+  return (b - a).dot((c - a).cross(d - a)) / 6.0;
+}
+
+struct CrossedEdge {
+  std::int32_t a, b;   // original node indices
+  double t;            // crossing at a + t (b - a)
+  Vec3 point;          // crossing point (surface) -- plane recomputes from phi
+  bool alive = true;   // still crossed (neither end snapped)
+};
+
+// Working mesh: the input arrays plus appended nodes and tets.
+struct Work {
+  const TetMesh& in;
+  Positions& X0;                  // the output copy's original rows (may move)
+  Tets& T0;
+  std::vector<Vec3> extraX;       // appended nodes
+  std::vector<Tet> extraT;        // appended tets
+  std::vector<std::int32_t> extraMat;
+  int N0, M0;
+
+  Work(const TetMesh& input, TetMesh& out) : in(input), X0(out.X), T0(out.T), N0(input.numNodes()), M0(input.numTets()) {}
+  int numNodes() const { return N0 + static_cast<int>(extraX.size()); }
+  int numTets() const { return M0 + static_cast<int>(extraT.size()); }
+  Vec3 x(int i) const { return i < N0 ? Vec3(X0.row(i).transpose()) : extraX[i - N0]; }
+  Tet tet(int t) const {
+    if (t < M0) return {T0(t, 0), T0(t, 1), T0(t, 2), T0(t, 3)};
+    return extraT[t - M0];
+  }
+  void setTet(int t, const Tet& v) {
+    if (t < M0) {
+      for (int k = 0; k < 4; ++k) T0(t, k) = v[k];
+    } else {
+      extraT[t - M0] = v;
+    }
+  }
+  int addTet(const Tet& v, std::int32_t material) {
+    extraT.push_back(v);
+    extraMat.push_back(material);
+    return numTets() - 1;
+  }
+  int addNode(const Vec3& p) {
+    extraX.push_back(p);
+    return numNodes() - 1;
+  }
+};
+
+int findLocal(const Tet& t, int v) {
+  for (int k = 0; k < 4; ++k)
+    if (t[k] == v) return k;
+  return -1;
+}
+
+}  // namespace
+
+double totalVolume(const TetMesh& mesh) {
+  double v = 0;
+  for (int t = 0; t < mesh.numTets(); ++t) v += tetVolume(mesh, t);
+  return v;
+}
+
+Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const Cut3DOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  const int N0 = input.numNodes(), M0 = input.numTets();
+  if (M0 == 0 || N0 == 0) return Error{"cut3d: empty mesh"};
+  if (input.material.size() != 0 && input.material.size() != M0) return Error{"cut3d: material size differs from #T"};
+  for (int t = 0; t < M0; ++t)
+    for (int k = 0; k < 4; ++k)
+      if (input.T(t, k) < 0 || input.T(t, k) >= N0)
+        return Error{"cut3d: tet " + std::to_string(t) + " has a node index out of range"};
+  if (!input.X.allFinite()) return Error{"cut3d: non-finite node coordinates"};
+  if (!(options.snap_region >= 0 && options.snap_region <= 0.5)) return Error{"cut3d: snap_region must be in [0, 0.5]"};
+
+  Cut3DResult result;
+  TetMesh& out = result.mesh;
+  out = input;
+  if (out.material.size() == 0) out.material = Labels::Zero(M0);
+  Cut3DReport& report = result.report;
+  TopologyChange& change = result.change;
+  Work w(input, out);
+
+  const Vec3 lo = input.X.colwise().minCoeff().transpose(), hi = input.X.colwise().maxCoeff().transpose();
+  const double diag = (hi - lo).norm();
+  if (!(diag > 0)) return Error{"cut3d: degenerate mesh bounding box"};
+  const double eps = options.on_surface_tolerance * diag;
+  const bool plane = surface.isPlane();
+
+  // Node -> tets (CSR) of the input mesh.
+  std::vector<std::int32_t> starOff(N0 + 1, 0), starTet(4 * static_cast<size_t>(M0));
+  for (int t = 0; t < M0; ++t)
+    for (int k = 0; k < 4; ++k) ++starOff[input.T(t, k) + 1];
+  for (int i = 0; i < N0; ++i) starOff[i + 1] += starOff[i];
+  {
+    std::vector<std::int32_t> fill(starOff.begin(), starOff.end() - 1);
+    for (int t = 0; t < M0; ++t)
+      for (int k = 0; k < 4; ++k) starTet[fill[input.T(t, k)]++] = t;
+  }
+
+  // 1. Classification. side: +1 / -1 strictly off the surface (where known), 0 on it or unknown.
+  std::vector<double> phi;            // plane: signed distances
+  std::vector<std::uint8_t> on;       // on the surface (grows with new nodes)
+  on.assign(N0, 0);
+  std::vector<CrossedEdge> crossed;
+  std::vector<Vec3> crossedNormal;    // surface: normal of the hit triangle per crossed edge
+  std::unordered_map<std::uint64_t, std::int32_t> edgeIndex;  // crossed edge -> index
+  std::vector<std::int32_t> crossedTets;
+  std::vector<std::int32_t> onNodes;  // original nodes on the surface
+  if (plane) {
+    phi.resize(N0);
+    const Vec3 n = surface.planeNormal(), p = surface.planePoint();
+    for (int i = 0; i < N0; ++i) {
+      phi[i] = n.dot(input.X.row(i).transpose() - p);
+      if (std::abs(phi[i]) <= eps) {
+        on[i] = 1;
+        onNodes.push_back(i);
+      }
+    }
+    for (int t = 0; t < M0; ++t) {
+      bool pos = false, neg = false;
+      for (int k = 0; k < 4; ++k) {
+        const double f = phi[input.T(t, k)];
+        pos = pos || f > eps;
+        neg = neg || f < -eps;
+      }
+      if (!(pos && neg)) continue;
+      crossedTets.push_back(t);
+      for (const auto& e : kEdge) {
+        const int a = input.T(t, e[0]), b = input.T(t, e[1]);
+        if (!((phi[a] > eps && phi[b] < -eps) || (phi[a] < -eps && phi[b] > eps))) continue;
+        const auto key = edgeKey(a, b);
+        if (edgeIndex.count(key)) continue;
+        const int lo_ = std::min(a, b), hi_ = std::max(a, b);
+        const double tt = phi[lo_] / (phi[lo_] - phi[hi_]);
+        edgeIndex.emplace(key, static_cast<std::int32_t>(crossed.size()));
+        crossed.push_back({lo_, hi_, tt, Vec3::Zero(), true});
+      }
+    }
+  } else {
+    std::vector<std::uint8_t> seen(N0, 0);
+    std::unordered_set<std::uint64_t> tested;
+    for (int t = 0; t < M0; ++t) {
+      Eigen::AlignedBox3d box;
+      for (int k = 0; k < 4; ++k) box.extend(input.X.row(input.T(t, k)).transpose());
+      if (!surface.mayTouch(box, eps)) continue;
+      for (int k = 0; k < 4; ++k) {
+        const int v = input.T(t, k);
+        if (seen[v]) continue;
+        seen[v] = 1;
+        if (std::abs(surface.signedDistance(input.X.row(v).transpose())) <= eps) {
+          on[v] = 1;
+          onNodes.push_back(v);
+        }
+      }
+      bool any = false;
+      for (const auto& e : kEdge) {
+        const int a = std::min(input.T(t, e[0]), input.T(t, e[1]));
+        const int b = std::max(input.T(t, e[0]), input.T(t, e[1]));
+        const auto key = edgeKey(a, b);
+        if (edgeIndex.count(key)) {
+          any = true;
+          continue;
+        }
+        if (on[a] || on[b] || !tested.insert(key).second) continue;
+        CutSurface::Hit hit;
+        if (!surface.intersectSegment(input.X.row(a).transpose(), input.X.row(b).transpose(), eps, &hit)) continue;
+        edgeIndex.emplace(key, static_cast<std::int32_t>(crossed.size()));
+        crossed.push_back({a, b, hit.t, hit.point, true});
+        crossedNormal.push_back(hit.normal);
+        any = true;
+      }
+      if (any) crossedTets.push_back(t);
+    }
+    std::sort(onNodes.begin(), onNodes.end());
+  }
+  report.crossed_edges = static_cast<int>(crossed.size());
+  report.crossed_elements = static_cast<int>(crossedTets.size());
+
+  auto crossingPoint = [&](const CrossedEdge& e) -> Vec3 {
+    if (!plane) return e.point;
+    const Vec3 xa = w.x(e.a), xb = w.x(e.b);
+    return xa + e.t * (xb - xa);
+  };
+
+  std::vector<std::int32_t> moved;
+  const bool deleting = options.method == CutMethod::Delete;
+  std::vector<std::uint8_t> deleted;
+
+  // 2. Snapping (hybrid / snap only).
+  const double region = options.method == CutMethod::Hybrid ? options.snap_region
+                        : options.method == CutMethod::Snap ? 0.5
+                                                            : 0.0;
+  if (region > 0 && !crossed.empty()) {
+    struct Candidate {
+      double frac;
+      std::int32_t node, edge;
+    };
+    std::vector<Candidate> candidates;
+    for (int e = 0; e < static_cast<int>(crossed.size()); ++e) {
+      const auto& c = crossed[e];
+      if (c.t <= region) candidates.push_back({c.t, c.a, e});
+      if (1.0 - c.t <= region) candidates.push_back({1.0 - c.t, c.b, e});
+    }
+    std::stable_sort(candidates.begin(), candidates.end(),
+                     [](const Candidate& x, const Candidate& y) { return x.frac < y.frac; });
+    const double cosFeature = std::cos(options.feature_angle_deg * M_PI / 180.0);
+    std::vector<std::uint8_t> refused(N0, 0);
+    for (const auto& cand : candidates) {
+      const int n = cand.node;
+      if (on[n] || !crossed[cand.edge].alive) continue;
+      const CrossedEdge& ce = crossed[cand.edge];
+      const int other = ce.a == n ? ce.b : ce.a;
+      // Boundary faces around n: faces containing n used by one tet of its star.
+      std::vector<std::pair<FaceKey, Vec3>> faces;
+      std::vector<int> faceCount;
+      for (int s = starOff[n]; s < starOff[n + 1]; ++s) {
+        const int t = starTet[s];
+        const int ln = findLocal(w.tet(t), n);
+        const Tet tv = w.tet(t);
+        for (int f = 0; f < 4; ++f) {
+          if (f == ln) continue;
+          const int i0 = tv[kFace[f][0]], i1 = tv[kFace[f][1]], i2 = tv[kFace[f][2]];
+          const FaceKey key = makeFace(i0, i1, i2);
+          bool found = false;
+          for (size_t q = 0; q < faces.size(); ++q)
+            if (faces[q].first == key) {
+              ++faceCount[q];
+              found = true;
+            }
+          if (!found) {
+            faces.emplace_back(key, (w.x(i1) - w.x(i0)).cross(w.x(i2) - w.x(i0)));
+            faceCount.push_back(1);
+          }
+        }
+      }
+      bool boundary = false, feature = false, boundaryEdge = false;
+      Vec3 firstNormal = Vec3::Zero();
+      for (size_t q = 0; q < faces.size(); ++q) {
+        if (faceCount[q] != 1) continue;
+        const Vec3 nrm = faces[q].second.normalized();
+        if (!boundary) firstNormal = nrm;
+        boundary = true;
+        if (nrm.dot(firstNormal) < cosFeature) feature = true;
+        const auto& v = faces[q].first.v;
+        if (v[0] == other || v[1] == other || v[2] == other) boundaryEdge = true;
+      }
+      Vec3 target;
+      if (boundary) {
+        // Boundary nodes stay within the boundary: only where it is flat around them (no
+        // feature edge or corner), sliding along the crossed boundary edge, or else within
+        // the boundary's tangent plane onto the cut.
+        if (feature) {
+          ++report.feature_skips;
+          continue;
+        }
+        if (boundaryEdge) {
+          target = crossingPoint(ce);
+        } else {
+          Vec3 m = Vec3::Zero();
+          for (size_t q = 0; q < faces.size(); ++q)
+            if (faceCount[q] == 1) m += faces[q].second.normalized();
+          m.normalize();
+          // Cut plane near n: the plane itself, or the plane of the hit triangle.
+          const Vec3 cn = plane ? surface.planeNormal() : crossedNormal[cand.edge];
+          const double dist = plane ? phi[n] : cn.dot(w.x(n) - ce.point);
+          const Vec3 d = cn - cn.dot(m) * m;  // steepest direction within the tangent plane
+          const double slope = cn.dot(d);
+          if (!(slope > 0.25)) {               // cut nearly parallel to the boundary there
+            ++report.feature_skips;
+            continue;
+          }
+          target = w.x(n) - (dist / slope) * d;
+          // A curved surface: the hit triangle's plane is only good where it is the surface.
+          if (!plane && std::abs(surface.signedDistance(target)) > 10 * eps) {
+            ++report.feature_skips;
+            continue;
+          }
+        }
+      } else if (plane) {
+        target = w.x(n) - phi[n] * surface.planeNormal();
+      } else {
+        target = ce.point;
+      }
+      // Guard: no inverted, flat or badly degraded tet; no collapsed edge. An interior node
+      // refused at the nearest point of the cut tries the crossing on its edge instead.
+      const Vec3 old = w.x(n);
+      bool ok = false;
+      for (int attempt = 0; attempt < (boundary ? 1 : 2) && !ok; ++attempt) {
+      if (attempt == 1) target = crossingPoint(ce);
+      ok = true;
+      for (int s = starOff[n]; s < starOff[n + 1] && ok; ++s) {
+        const Tet tv = w.tet(starTet[s]);
+        Vec3 p[4], q[4];
+        for (int k = 0; k < 4; ++k) {
+          p[k] = w.x(tv[k]);
+          q[k] = tv[k] == n ? target : p[k];
+        }
+        const double v0 = signedVolume(p[0], p[1], p[2], p[3]);
+        const double v1 = signedVolume(q[0], q[1], q[2], q[3]);
+        if (!(v1 > 1e-3 * v0)) {
+          ok = false;
+          break;
+        }
+        const double qa = radiusRatio(q[0], q[1], q[2], q[3]);
+        if (qa < options.min_quality && qa < radiusRatio(p[0], p[1], p[2], p[3])) ok = false;
+        for (int k = 0; k < 4 && ok; ++k) {
+          if (tv[k] == n) continue;
+          if ((q[k] - target).norm() < options.min_edge_fraction * (p[k] - old).norm()) ok = false;
+        }
+      }
+      }
+      if (!ok) {
+        if (!refused[n]) ++report.refused_snaps;
+        refused[n] = 1;
+        continue;
+      }
+      w.X0.row(n) = target.transpose();
+      on[n] = 1;
+      if (plane) phi[n] = 0;
+      onNodes.push_back(n);
+      moved.push_back(n);
+      ++report.snapped_nodes;
+      if (boundary) ++report.boundary_snaps;
+      for (int s = starOff[n]; s < starOff[n + 1]; ++s) {
+        const Tet tv = w.tet(starTet[s]);
+        for (int k = 0; k < 4; ++k) {
+          if (tv[k] == n) continue;
+          const auto it = edgeIndex.find(edgeKey(n, tv[k]));
+          if (it != edgeIndex.end()) crossed[it->second].alive = false;
+        }
+      }
+    }
+  }
+
+  // 3. Subdivision: split every edge still crossed (conforming bisection of the tets around
+  //    it), or, for deletion, remove the crossed tets.
+  std::vector<std::int32_t> localOf(M0, -1);   // original tet -> index into fragments
+  std::vector<std::vector<std::int32_t>> fragments;
+  std::vector<std::int32_t> splitOriginals;
+  std::vector<NewNode>& newNodes = change.new_nodes;
+  if (deleting) {
+    deleted.assign(M0, 0);
+    for (int t : crossedTets) deleted[t] = 1;
+    report.deleted_elements = static_cast<int>(crossedTets.size());
+  } else {
+    for (auto& ce : crossed) {
+      if (!ce.alive) continue;
+      const Vec3 p = crossingPoint(ce);
+      const int pn = w.addNode(p);
+      on.push_back(1);
+      NewNode nn;
+      nn.id = pn;
+      nn.num_parents = 2;
+      nn.parents = {ce.a, ce.b, -1};
+      nn.weights = {1.0 - ce.t, ce.t, 0.0};
+      newNodes.push_back(nn);
+      ++report.split_edges;
+      for (int s = starOff[ce.a]; s < starOff[ce.a + 1]; ++s) {
+        const int o = starTet[s];
+        if (findLocal(Tet{input.T(o, 0), input.T(o, 1), input.T(o, 2), input.T(o, 3)}, ce.b) < 0) continue;
+        if (localOf[o] < 0) {
+          localOf[o] = static_cast<std::int32_t>(fragments.size());
+          fragments.push_back({o});
+          splitOriginals.push_back(o);
+        }
+        auto& list = fragments[localOf[o]];
+        const size_t count = list.size();
+        for (size_t f = 0; f < count; ++f) {
+          const int t = list[f];
+          Tet tv = w.tet(t);
+          const int la = findLocal(tv, ce.a), lb = findLocal(tv, ce.b);
+          if (la < 0 || lb < 0) continue;
+          Tet other = tv;
+          tv[lb] = pn;
+          other[la] = pn;
+          w.setTet(t, tv);
+          list.push_back(w.addTet(other, out.material(o)));
+        }
+      }
+    }
+    report.split_elements = static_cast<int>(splitOriginals.size());
+  }
+
+  // 4. Separation. Local tets: the current stars of all nodes on the cut.
+  auto isDeleted = [&](int t) { return deleting && t < M0 && deleted[t]; };
+  std::vector<std::int32_t> local;
+  {
+    std::vector<std::uint8_t> inLocal(w.numTets(), 0);
+    auto add = [&](int t) {
+      if (!inLocal[t] && !isDeleted(t)) {
+        inLocal[t] = 1;
+        local.push_back(t);
+      }
+    };
+    for (int n : onNodes)
+      for (int s = starOff[n]; s < starOff[n + 1]; ++s) {
+        const int o = starTet[s];
+        if (localOf[o] < 0) {
+          add(o);
+        } else {
+          for (int f : fragments[localOf[o]]) add(f);
+        }
+      }
+    for (const auto& frag : fragments)
+      for (int f : frag) add(f);
+  }
+  struct FaceUse {
+    std::int32_t tet[2];
+    std::int8_t opposite[2];
+    int count = 0;
+  };
+  std::unordered_map<FaceKey, FaceUse, FaceKeyHash> onFaces;
+  if (options.separate) {
+    for (int t : local) {
+      const Tet tv = w.tet(t);
+      for (int f = 0; f < 4; ++f) {
+        const int i0 = tv[kFace[f][0]], i1 = tv[kFace[f][1]], i2 = tv[kFace[f][2]];
+        if (!on[i0] || !on[i1] || !on[i2]) continue;
+        FaceUse& u = onFaces[makeFace(i0, i1, i2)];
+        if (u.count < 2) {
+          u.tet[u.count] = t;
+          u.opposite[u.count] = static_cast<std::int8_t>(f);
+        }
+        ++u.count;
+      }
+    }
+  }
+  std::unordered_set<FaceKey, FaceKeyHash> cutFaces;
+  std::vector<std::pair<std::int32_t, std::int8_t>> cutFaceSides;  // (tet, opposite local vertex)
+  for (const auto& [key, use] : onFaces) {
+    if (use.count != 2) continue;
+    if (!plane) {
+      // The face must lie in the surface, not just have its corners on it.
+      const Vec3 a = w.x(key.v[0]), b = w.x(key.v[1]), c = w.x(key.v[2]);
+      const double size = std::max({(b - a).norm(), (c - a).norm(), (c - b).norm()});
+      if (std::abs(surface.signedDistance((a + b + c) / 3.0)) > eps + 0.05 * size) continue;
+    }
+    cutFaces.insert(key);
+  }
+  // Deterministic order for the side records.
+  std::vector<FaceKey> cutFaceList(cutFaces.begin(), cutFaces.end());
+  std::sort(cutFaceList.begin(), cutFaceList.end(), [](const FaceKey& x, const FaceKey& y) { return x.v < y.v; });
+  for (const auto& key : cutFaceList) {
+    const auto& use = onFaces[key];
+    cutFaceSides.emplace_back(use.tet[0], use.opposite[0]);
+    cutFaceSides.emplace_back(use.tet[1], use.opposite[1]);
+  }
+  report.cut_faces = static_cast<int>(cutFaceList.size());
+
+  std::vector<std::int32_t> cutNodes;
+  if (!cutFaceList.empty()) {
+    for (const auto& key : cutFaceList)
+      for (int v : key.v) cutNodes.push_back(v);
+    std::sort(cutNodes.begin(), cutNodes.end());
+    cutNodes.erase(std::unique(cutNodes.begin(), cutNodes.end()), cutNodes.end());
+    std::vector<std::int32_t> slot(w.numNodes(), -1);
+    for (size_t i = 0; i < cutNodes.size(); ++i) slot[cutNodes[i]] = static_cast<std::int32_t>(i);
+    std::vector<std::vector<std::int32_t>> star(cutNodes.size());
+    for (int t : local) {
+      const Tet tv = w.tet(t);
+      for (int k = 0; k < 4; ++k)
+        if (slot[tv[k]] >= 0) star[slot[tv[k]]].push_back(t);
+    }
+    const size_t numCut = cutNodes.size();
+    std::vector<int> parent;
+    std::vector<std::pair<FaceKey, int>> faceOwner;
+    for (size_t i = 0; i < numCut; ++i) {
+      const int n = cutNodes[i];
+      auto& st = star[i];
+      std::sort(st.begin(), st.end());
+      parent.resize(st.size());
+      std::iota(parent.begin(), parent.end(), 0);
+      auto find = [&](int x) {
+        while (parent[x] != x) x = parent[x] = parent[parent[x]];
+        return x;
+      };
+      faceOwner.clear();
+      for (size_t j = 0; j < st.size(); ++j) {
+        const Tet tv = w.tet(st[j]);
+        const int ln = findLocal(tv, n);
+        for (int f = 0; f < 4; ++f) {
+          if (f == ln) continue;
+          faceOwner.emplace_back(makeFace(tv[kFace[f][0]], tv[kFace[f][1]], tv[kFace[f][2]]), static_cast<int>(j));
+        }
+      }
+      std::sort(faceOwner.begin(), faceOwner.end(),
+                [](const std::pair<FaceKey, int>& x, const std::pair<FaceKey, int>& y) { return x.first < y.first; });
+      for (size_t q = 0; q + 1 < faceOwner.size(); ++q)
+        if (faceOwner[q].first == faceOwner[q + 1].first && !cutFaces.count(faceOwner[q].first))
+          parent[find(faceOwner[q].second)] = find(faceOwner[q + 1].second);
+      // The group of the first tet keeps n; every other group gets a copy.
+      std::vector<int> copyOf(st.size(), -1);
+      const int keep = find(0);
+      for (size_t j = 0; j < st.size(); ++j) {
+        const int g = find(static_cast<int>(j));
+        if (g == keep) continue;
+        if (copyOf[g] < 0) {
+          copyOf[g] = w.addNode(w.x(n));
+          on.push_back(1);
+          NewNode nn;
+          nn.id = copyOf[g];
+          nn.duplicate = true;
+          if (n < N0) {
+            nn.num_parents = 1;
+            nn.parents = {n, -1, -1};
+            nn.weights = {1.0, 0.0, 0.0};
+          } else {
+            const NewNode& src = newNodes[n - N0];  // split nodes come first, in id order
+            nn.num_parents = src.num_parents;
+            nn.parents = src.parents;
+            nn.weights = src.weights;
+          }
+          newNodes.push_back(nn);
+          cutNodes.push_back(copyOf[g]);
+          ++report.duplicated_nodes;
+        }
+        Tet tv = w.tet(st[j]);
+        tv[findLocal(tv, n)] = copyOf[g];
+        w.setTet(st[j], tv);
+      }
+    }
+    std::sort(cutNodes.begin(), cutNodes.end());
+  }
+  for (const auto& [t, opp] : cutFaceSides) {
+    const Tet tv = w.tet(t);
+    change.cut_faces.push_back({tv[kFace[opp][0]], tv[kFace[opp][1]], tv[kFace[opp][2]]});
+  }
+  report.cut_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+
+  // Assemble.
+  const int N1 = w.numNodes(), M1 = w.numTets();
+  out.X.conservativeResize(N1, 3);
+  for (int i = N0; i < N1; ++i) out.X.row(i) = w.extraX[i - N0].transpose();
+  out.T.conservativeResize(M1, 4);
+  out.material.conservativeResize(M1);
+  for (int t = M0; t < M1; ++t) {
+    for (int k = 0; k < 4; ++k) out.T(t, k) = w.extraT[t - M0][k];
+    out.material(t) = w.extraMat[t - M0];
+  }
+
+  change.old_num_nodes = N0;
+  change.old_num_elements = M0;
+  change.node_old_to_new.resize(N0);
+  std::iota(change.node_old_to_new.begin(), change.node_old_to_new.end(), 0);
+  change.element_old_to_new.resize(M0);
+  std::iota(change.element_old_to_new.begin(), change.element_old_to_new.end(), 0);
+  std::sort(splitOriginals.begin(), splitOriginals.end());
+  for (int o : splitOriginals) {
+    change.element_old_to_new[o] = -1;
+    change.removed_elements.push_back(o);
+    for (int f : fragments[localOf[o]]) change.added_elements.push_back(f);
+  }
+  std::sort(change.added_elements.begin(), change.added_elements.end());
+
+  // 5. Local optimisation (hybrid).
+  if (options.method == CutMethod::Hybrid && options.optimize.enabled && !cutNodes.empty()) {
+    const auto optStart = std::chrono::steady_clock::now();
+    optimizeAfterCut3D(out, cutNodes, options.optimize, &moved, &report.optimize_iterations);
+    report.optimize_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - optStart).count();
+  }
+  std::sort(moved.begin(), moved.end());
+  moved.erase(std::unique(moved.begin(), moved.end()), moved.end());
+  // Only surviving old nodes count as moved (new ones are described by new_nodes).
+  for (int n : moved)
+    if (n < N0) change.moved_nodes.push_back(n);
+  report.optimized_nodes = static_cast<int>(moved.size()) - report.snapped_nodes;
+  change.cut_nodes = cutNodes;
+
+  if (deleting) {
+    // Compact: drop deleted tets and the nodes no longer used.
+    std::vector<std::int32_t> tetMap(M1, -1), nodeMap(N1, -1);
+    int mt = 0;
+    for (int t = 0; t < M1; ++t)
+      if (!(t < M0 && deleted[t])) tetMap[t] = mt++;
+    for (int t = 0; t < M1; ++t)
+      if (tetMap[t] >= 0)
+        for (int k = 0; k < 4; ++k) nodeMap[out.T(t, k)] = 1;
+    int mn = 0;
+    for (int i = 0; i < N1; ++i) nodeMap[i] = nodeMap[i] > 0 ? mn++ : -1;
+    TetMesh compact;
+    compact.X.resize(mn, 3);
+    compact.T.resize(mt, 4);
+    compact.material.resize(mt);
+    for (int i = 0; i < N1; ++i)
+      if (nodeMap[i] >= 0) compact.X.row(nodeMap[i]) = out.X.row(i);
+    for (int t = 0; t < M1; ++t)
+      if (tetMap[t] >= 0) {
+        for (int k = 0; k < 4; ++k) compact.T(tetMap[t], k) = nodeMap[out.T(t, k)];
+        compact.material(tetMap[t]) = out.material(t);
+      }
+    out = std::move(compact);
+    for (int i = 0; i < N0; ++i) change.node_old_to_new[i] = nodeMap[i];
+    for (int t = 0; t < M0; ++t) {
+      change.element_old_to_new[t] = tetMap[t];
+      if (tetMap[t] < 0) change.removed_elements.push_back(t);
+    }
+    auto remapList = [&](std::vector<std::int32_t>& list) {
+      std::vector<std::int32_t> kept;
+      for (int n : list)
+        if (nodeMap[n] >= 0) kept.push_back(nodeMap[n]);
+      list = kept;
+    };
+    remapList(change.cut_nodes);
+    for (auto& nn : change.new_nodes) nn.id = nodeMap[nn.id];
+    change.new_nodes.erase(std::remove_if(change.new_nodes.begin(), change.new_nodes.end(),
+                                          [](const NewNode& nn) { return nn.id < 0; }),
+                           change.new_nodes.end());
+    for (auto& f : change.cut_faces)
+      for (auto& v : f) v = nodeMap[v];
+  }
+  change.new_num_nodes = out.numNodes();
+  change.new_num_elements = out.numTets();
+  return result;
+}
+
+Components3D tetComponents(const TetMesh& mesh, const std::vector<int>& anchored) {
+  Components3D c;
+  const int M = std::max(0, mesh.numTets());
+  c.label = Eigen::VectorXi::Constant(M, -1);
+  // Faces sorted by key; equal neighbours share a face.
+  struct F {
+    std::array<std::int32_t, 3> v;
+    std::int32_t tet;
+  };
+  std::vector<F> faces;
+  faces.reserve(4 * static_cast<size_t>(M));
+  for (int t = 0; t < M; ++t)
+    for (int f = 0; f < 4; ++f) {
+      FaceKey k = makeFace(mesh.T(t, kFace[f][0]), mesh.T(t, kFace[f][1]), mesh.T(t, kFace[f][2]));
+      faces.push_back({k.v, t});
+    }
+  std::sort(faces.begin(), faces.end(), [](const F& x, const F& y) { return x.v < y.v; });
+  std::vector<int> parent(static_cast<size_t>(M));
+  std::iota(parent.begin(), parent.end(), 0);
+  auto find = [&](int x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+  };
+  for (size_t i = 0; i + 1 < faces.size(); ++i)
+    if (faces[i].v == faces[i + 1].v) parent[find(faces[i].tet)] = find(faces[i + 1].tet);
+  std::vector<int> id(static_cast<size_t>(M), -1);
+  for (int t = 0; t < M; ++t) {
+    const int r = find(t);
+    if (id[r] < 0) {
+      id[r] = c.count++;
+      c.volume.push_back(0.0);
+      c.elements.push_back(0);
+    }
+    c.label(t) = id[r];
+    c.volume[id[r]] += tetVolume(mesh, t);
+    ++c.elements[id[r]];
+  }
+  c.free.assign(c.count, true);
+  std::vector<std::uint8_t> isAnchored(mesh.numNodes(), 0);
+  for (int n : anchored)
+    if (n >= 0 && n < mesh.numNodes()) isAnchored[n] = 1;
+  for (int t = 0; t < M; ++t)
+    for (int k = 0; k < 4; ++k)
+      if (isAnchored[mesh.T(t, k)]) c.free[c.label(t)] = false;
+  return c;
+}
+
+int countStraddling(const TetMesh& mesh, const Eigen::Vector3d& point, const Eigen::Vector3d& normal, double eps) {
+  const Vec3 n = normal.normalized();
+  int count = 0;
+  for (int t = 0; t < mesh.numTets(); ++t) {
+    bool pos = false, neg = false;
+    for (int k = 0; k < 4; ++k) {
+      const double f = n.dot(mesh.X.row(mesh.T(t, k)).transpose() - point);
+      pos = pos || f > eps;
+      neg = neg || f < -eps;
+    }
+    if (pos && neg) ++count;
+  }
+  return count;
+}
+
+int countFacesSharedAcross(const TetMesh& mesh, const Eigen::Vector3d& point, const Eigen::Vector3d& normal,
+                           double eps) {
+  const Vec3 n = normal.normalized();
+  auto tetSide = [&](int t) {
+    double best = 0;
+    for (int k = 0; k < 4; ++k) {
+      const double f = n.dot(mesh.X.row(mesh.T(t, k)).transpose() - point);
+      if (std::abs(f) > std::abs(best)) best = f;
+    }
+    return best > eps ? 1 : best < -eps ? -1 : 0;
+  };
+  std::unordered_map<FaceKey, int, FaceKeyHash> owner;
+  int count = 0;
+  for (int t = 0; t < mesh.numTets(); ++t)
+    for (int f = 0; f < 4; ++f) {
+      const FaceKey k = makeFace(mesh.T(t, kFace[f][0]), mesh.T(t, kFace[f][1]), mesh.T(t, kFace[f][2]));
+      auto [it, inserted] = owner.emplace(k, t);
+      if (!inserted && tetSide(it->second) * tetSide(t) < 0) ++count;
+    }
+  return count;
+}
+
+}  // namespace hysim::cutting

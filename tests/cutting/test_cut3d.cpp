@@ -1,0 +1,411 @@
+// 3D cutting: the hybrid cases, the baselines, the hard numerical cases and randomized cuts,
+// each result checked by validate(), side separation, volume and the TopologyChange.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <random>
+
+#include "box_mesh.hpp"
+#include "hysim/cutting/cut3d.hpp"
+#include "hysim/cutting/mesh_io.hpp"
+#include "hysim/cutting/mesh_stats.hpp"
+
+namespace hysim::cutting {
+namespace {
+
+using Vec3 = Eigen::Vector3d;
+
+TetMesh singleTet() {
+  TetMesh m;
+  m.X.resize(4, 3);
+  m.X << 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1;
+  m.T.resize(1, 4);
+  m.T << 0, 1, 2, 3;
+  m.material = Labels::Zero(1);
+  return m;
+}
+
+Cut3DOptions withMethod(CutMethod method) {
+  Cut3DOptions o;
+  o.method = method;
+  return o;
+}
+
+// Checks every invariant of a plane cut; returns the result.
+Cut3DResult cutAndCheck(const TetMesh& mesh, const Vec3& p, const Vec3& n, const Cut3DOptions& options,
+                        double volumeTol = 1e-9) {
+  auto plane = CutSurface::plane(p, n);
+  EXPECT_TRUE(plane.ok());
+  auto r = cut3d(mesh, *plane, options);
+  EXPECT_TRUE(r.ok()) << r.error();
+  if (!r.ok()) return {};
+  const auto v = validate(r->mesh);
+  EXPECT_TRUE(v.ok()) << v.error();
+  const double eps = 1e-7;
+  EXPECT_EQ(countStraddling(r->mesh, p, n, eps), 0);
+  EXPECT_EQ(countFacesSharedAcross(r->mesh, p, n, eps), 0);
+  const double v0 = totalVolume(mesh);
+  if (options.method != CutMethod::Delete) {
+    EXPECT_NEAR(totalVolume(r->mesh), v0, volumeTol * std::abs(v0));
+  }
+  // TopologyChange consistency.
+  const auto& c = r->change;
+  EXPECT_EQ(c.old_num_nodes, mesh.numNodes());
+  EXPECT_EQ(c.old_num_elements, mesh.numTets());
+  EXPECT_EQ(c.new_num_nodes, r->mesh.numNodes());
+  EXPECT_EQ(c.new_num_elements, r->mesh.numTets());
+  EXPECT_EQ(static_cast<int>(c.node_old_to_new.size()), mesh.numNodes());
+  EXPECT_EQ(static_cast<int>(c.element_old_to_new.size()), mesh.numTets());
+  for (size_t i = 1; i < c.new_nodes.size(); ++i) EXPECT_LT(c.new_nodes[i - 1].id, c.new_nodes[i].id);
+  for (const auto& nn : c.new_nodes) {
+    double sum = 0;
+    for (int k = 0; k < nn.num_parents; ++k) {
+      EXPECT_GE(nn.parents[k], 0);
+      EXPECT_LT(nn.parents[k], mesh.numNodes());
+      sum += nn.weights[k];
+    }
+    EXPECT_NEAR(sum, 1.0, 1e-12);
+  }
+  int removed = 0;
+  for (int t = 0; t < mesh.numTets(); ++t) removed += c.element_old_to_new[t] < 0;
+  EXPECT_EQ(removed, static_cast<int>(c.removed_elements.size()));
+  EXPECT_EQ(r->mesh.numTets(), mesh.numTets() - removed + static_cast<int>(c.added_elements.size()));
+  return std::move(r).value();
+}
+
+int components(const TetMesh& m) { return tetComponents(m).count; }
+
+// --- single tet: the subdivision patterns -------------------------------------------------
+
+TEST(Cut3D, SingleTetOneThreeSplitStandard) {
+  const TetMesh m = singleTet();
+  const auto r = cutAndCheck(m, Vec3(0.5, 0, 0), Vec3(1, 1, 1), withMethod(CutMethod::Standard));
+  EXPECT_EQ(r.report.split_edges, 3);
+  EXPECT_EQ(r.mesh.numTets(), 4);          // 1 on the node's side + 3 (prism)
+  EXPECT_EQ(r.report.duplicated_nodes, 3); // the cut triangle, one copy per side
+  EXPECT_EQ(r.mesh.numNodes(), 10);
+  EXPECT_EQ(components(r.mesh), 2);
+  EXPECT_EQ(r.change.cut_faces.size(), 2u);
+  EXPECT_EQ(r.change.removed_elements, std::vector<std::int32_t>{0});
+  EXPECT_EQ(r.change.added_elements.size(), 4u);
+}
+
+TEST(Cut3D, SingleTetTwoTwoSplitStandard) {
+  const TetMesh m = singleTet();
+  // Nodes 0, 3 (x + y small) against 1, 2.
+  const auto r = cutAndCheck(m, Vec3(0.5, 0, 0), Vec3(1, 1, 0), withMethod(CutMethod::Standard));
+  EXPECT_EQ(r.report.split_edges, 4);
+  EXPECT_EQ(r.mesh.numTets(), 6);
+  EXPECT_EQ(r.report.duplicated_nodes, 4);
+  EXPECT_EQ(components(r.mesh), 2);
+}
+
+TEST(Cut3D, SingleTetThroughOneNodeSplitsOppositeEdgesOnly) {
+  const TetMesh m = singleTet();
+  // Plane through node 0 separating node 1 from nodes 2, 3: a cut through a node.
+  const auto r = cutAndCheck(m, Vec3(0, 0, 0), Vec3(1, -1, -1), withMethod(CutMethod::Standard));
+  EXPECT_EQ(r.report.split_edges, 2);   // edges 1-2 and 1-3
+  EXPECT_EQ(r.mesh.numTets(), 3);
+  EXPECT_EQ(components(r.mesh), 2);
+}
+
+TEST(Cut3D, SingleTetThroughEdgeSplitsOneEdge) {
+  const TetMesh m = singleTet();
+  // Plane containing edge 0-3 (the z axis), separating node 1 from node 2.
+  const auto r = cutAndCheck(m, Vec3(0, 0, 0), Vec3(1, -1, 0), withMethod(CutMethod::Standard));
+  EXPECT_EQ(r.report.split_edges, 1);
+  EXPECT_EQ(r.mesh.numTets(), 2);
+  EXPECT_EQ(r.report.duplicated_nodes, 3);
+  EXPECT_EQ(components(r.mesh), 2);
+}
+
+TEST(Cut3D, SingleTetFacePlaneAndBoundaryIsNoOp) {
+  const TetMesh m = singleTet();
+  for (CutMethod method : {CutMethod::Hybrid, CutMethod::Standard, CutMethod::Snap, CutMethod::Delete}) {
+    const auto r = cutAndCheck(m, Vec3(0, 0, 0), Vec3(0, 0, 1), withMethod(method));
+    EXPECT_EQ(r.mesh.numTets(), 1);
+    EXPECT_EQ(r.mesh.numNodes(), 4);
+    EXPECT_TRUE(r.change.new_nodes.empty());
+    EXPECT_EQ(r.mesh.X, m.X);
+  }
+}
+
+TEST(Cut3D, DeleteRemovesCrossedTet) {
+  const TetMesh box = testing::boxTetMesh(2, 2, 2, 1.0);
+  const auto r = cutAndCheck(box, Vec3(0, 0, 1.5), Vec3(0, 0, 1), withMethod(CutMethod::Delete));
+  EXPECT_EQ(r.mesh.numTets(), 48 - 24);
+  EXPECT_EQ(r.report.deleted_elements, 24);
+  EXPECT_EQ(components(r.mesh), 1);
+  EXPECT_TRUE(validate(r.mesh, {.requireAllNodesUsed = true}).ok());
+}
+
+// --- the four hybrid cases (0..3 nodes of a tet separated) on a box ------------------------
+
+TEST(Cut3D, HybridNearNodesSnapsInsteadOfSubdividing) {
+  const TetMesh box = testing::boxTetMesh(2, 2, 2, 1.0);
+  auto o = withMethod(CutMethod::Hybrid);
+  o.optimize.enabled = false;
+  const auto r = cutAndCheck(box, Vec3(0, 0, 1.1), Vec3(0, 0, 1), o);
+  // The interior node and the four face-centre nodes at z = 1 slide up; the four nodes on the
+  // box's vertical edges are features and stay, so their edges are subdivided.
+  EXPECT_EQ(r.report.snapped_nodes, 5);
+  EXPECT_EQ(r.report.boundary_snaps, 4);
+  EXPECT_GT(r.report.refused_snaps + r.report.split_edges, 0);
+  EXPECT_EQ(components(r.mesh), 2);
+  // Tets whose three nodes were snapped have a face in the cut: three nodes separated.
+  EXPECT_GT(r.report.cut_faces, 0);
+  const auto s0 = computeStats(box), s1 = computeStats(r.mesh);
+  EXPECT_LE(s1.elements, s0.elements * 1.5);
+}
+
+TEST(Cut3D, HybridInteriorPlaneCutFourCases) {
+  // A finer box: the plane at z = 2.2 crosses edges at t = 0.2 from the z = 2 nodes.
+  const TetMesh box = testing::boxTetMesh(4, 4, 4, 1.0);
+  auto o = withMethod(CutMethod::Hybrid);
+  o.optimize.enabled = false;
+  const auto r = cutAndCheck(box, Vec3(0, 0, 2.2), Vec3(0, 0, 1), o);
+  EXPECT_GE(r.report.snapped_nodes, 9);   // at least the 3x3 interior nodes
+  EXPECT_EQ(components(r.mesh), 2);
+  // Only the feature nodes (box edges) subdivide.
+  EXPECT_LE(r.mesh.numTets(), box.numTets() * 1.1);
+}
+
+TEST(Cut3D, HybridTiltedPlaneAllCasesValid) {
+  const TetMesh box = testing::boxTetMesh(4, 4, 4, 1.0);
+  const auto r = cutAndCheck(box, Vec3(2.1, 2.0, 1.9), Vec3(0.3, 0.2, 1.0), withMethod(CutMethod::Hybrid), 1e-9);
+  EXPECT_GT(r.report.snapped_nodes, 0);
+  EXPECT_GT(r.report.split_edges, 0);
+  EXPECT_EQ(components(r.mesh), 2);
+}
+
+TEST(Cut3D, SnapThresholdPlusMinusEpsilon) {
+  const TetMesh box = testing::boxTetMesh(2, 2, 2, 1.0);
+  auto o = withMethod(CutMethod::Hybrid);
+  o.snap_region = 0.3;
+  o.optimize.enabled = false;
+  const auto below = cutAndCheck(box, Vec3(0, 0, 1.3 - 1e-6), Vec3(0, 0, 1), o);
+  const auto above = cutAndCheck(box, Vec3(0, 0, 1.3 + 1e-6), Vec3(0, 0, 1), o);
+  EXPECT_GT(below.report.snapped_nodes, 0);
+  EXPECT_EQ(above.report.snapped_nodes, 0);
+  EXPECT_EQ(above.report.split_edges, above.report.crossed_edges);
+}
+
+TEST(Cut3D, InFacePlaneSeparatesWithoutNewElements) {
+  const TetMesh box = testing::boxTetMesh(2, 2, 2, 1.0);
+  for (CutMethod method : {CutMethod::Hybrid, CutMethod::Standard, CutMethod::Snap}) {
+    const auto r = cutAndCheck(box, Vec3(0, 0, 1), Vec3(0, 0, 1), withMethod(method));
+    EXPECT_EQ(r.mesh.numTets(), box.numTets());
+    EXPECT_EQ(r.report.duplicated_nodes, 9);
+    EXPECT_EQ(components(r.mesh), 2);
+  }
+  // x = y is a union of Kuhn faces too.
+  const auto d = cutAndCheck(box, Vec3(0, 0, 0), Vec3(1, -1, 0), withMethod(CutMethod::Standard));
+  EXPECT_EQ(d.mesh.numTets(), box.numTets());
+  EXPECT_EQ(components(d.mesh), 2);
+}
+
+TEST(Cut3D, ThroughNodeAndAlongEdge) {
+  const TetMesh box = testing::boxTetMesh(3, 3, 3, 1.0);
+  for (CutMethod method : {CutMethod::Hybrid, CutMethod::Standard, CutMethod::Snap, CutMethod::Delete}) {
+    // Through node (1,1,1), general direction.
+    cutAndCheck(box, Vec3(1, 1, 1), Vec3(1, 2, 3), withMethod(method), 1e-9);
+    // Along the vertical edges at x = y = 1 without containing a face.
+    const auto r = cutAndCheck(box, Vec3(1, 1, 0), Vec3(1, 2, 0), withMethod(method), 1e-9);
+    if (method != CutMethod::Delete) {
+      EXPECT_EQ(components(r.mesh), 2);
+    }
+  }
+}
+
+TEST(Cut3D, RepeatedCutAtSamePlaceIsNoOp) {
+  const TetMesh box = testing::boxTetMesh(3, 3, 3, 1.0);
+  for (CutMethod method : {CutMethod::Hybrid, CutMethod::Standard}) {
+    const auto a = cutAndCheck(box, Vec3(0, 0, 1.5), Vec3(0.1, 0, 1), withMethod(method));
+    const auto b = cutAndCheck(a.mesh, Vec3(0, 0, 1.5), Vec3(0.1, 0, 1), withMethod(method));
+    EXPECT_EQ(b.mesh.numTets(), a.mesh.numTets());
+    EXPECT_EQ(b.mesh.numNodes(), a.mesh.numNodes());
+    EXPECT_TRUE(b.change.new_nodes.empty());
+  }
+}
+
+TEST(Cut3D, SuccessiveParallelCuts) {
+  TetMesh m = testing::boxTetMesh(4, 4, 4, 1.0);
+  const double v0 = totalVolume(m);
+  for (int i = 0; i < 6; ++i) {
+    const auto r = cutAndCheck(m, Vec3(0, 0, 0.37 + 0.55 * i), Vec3(0.05, 0.02, 1), withMethod(CutMethod::Hybrid));
+    m = r.mesh;
+  }
+  EXPECT_NEAR(totalVolume(m), v0, 1e-9 * v0);
+  EXPECT_GE(components(m), 5);
+}
+
+TEST(Cut3D, StandardSplitNodesInterpolateParents) {
+  const TetMesh box = testing::boxTetMesh(3, 3, 3, 1.0);
+  const auto r = cutAndCheck(box, Vec3(1.3, 1.4, 1.5), Vec3(1, 0.4, 0.7), withMethod(CutMethod::Standard));
+  for (const auto& nn : r.change.new_nodes) {
+    Vec3 x = Vec3::Zero();
+    for (int k = 0; k < nn.num_parents; ++k) x += nn.weights[k] * box.X.row(nn.parents[k]).transpose();
+    EXPECT_LT((x - r.mesh.X.row(nn.id).transpose()).norm(), 1e-12);
+  }
+  // Every cut face has a twin with the same positions, opposite orientation.
+  EXPECT_EQ(r.change.cut_faces.size() % 2, 0u);
+  EXPECT_EQ(static_cast<int>(r.change.cut_faces.size()), 2 * r.report.cut_faces);
+}
+
+TEST(Cut3D, RandomizedPlanesAllMethods) {
+  std::mt19937 rng(42);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const TetMesh meshes[] = {testing::boxTetMesh(3, 3, 3, 1.0), testing::boxTetMesh(5, 3, 4, 0.7)};
+  for (const auto& mesh : meshes) {
+    const Vec3 lo = mesh.X.colwise().minCoeff().transpose(), hi = mesh.X.colwise().maxCoeff().transpose();
+    for (int trial = 0; trial < 12; ++trial) {
+      const Vec3 p = 0.5 * (lo + hi) + 0.3 * Vec3(u(rng), u(rng), u(rng)).cwiseProduct(hi - lo);
+      const Vec3 n(u(rng), u(rng), u(rng));
+      for (CutMethod method : {CutMethod::Hybrid, CutMethod::Standard, CutMethod::Snap, CutMethod::Delete}) {
+        SCOPED_TRACE(std::string(cutMethodName(method)) + " trial " + std::to_string(trial));
+        const auto r = cutAndCheck(mesh, p, n, withMethod(method), 1e-9);
+        if (method == CutMethod::Standard) {
+          EXPECT_EQ(r.report.split_edges, r.report.crossed_edges);
+        }
+      }
+    }
+  }
+}
+
+// --- triangulated cut surfaces -----------------------------------------------------------
+
+// A strip of a cylinder (axis along y, radius R, centred at c), the loop's swept surface.
+CutSurface cylinderStrip(const Vec3& c, double radius, double angle0, double angle1, double y0, double y1, int nu,
+                         int nv) {
+  Positions X((nu + 1) * (nv + 1), 3);
+  Tris F(2 * nu * nv, 3);
+  for (int j = 0; j <= nv; ++j)
+    for (int i = 0; i <= nu; ++i) {
+      const double a = angle0 + (angle1 - angle0) * i / nu;
+      X.row(j * (nu + 1) + i) << c.x() + radius * std::cos(a), y0 + (y1 - y0) * j / nv, c.z() + radius * std::sin(a);
+    }
+  int f = 0;
+  for (int j = 0; j < nv; ++j)
+    for (int i = 0; i < nu; ++i) {
+      const int v00 = j * (nu + 1) + i, v10 = v00 + 1, v01 = v00 + nu + 1, v11 = v01 + 1;
+      F.row(f++) << v00, v10, v11;
+      F.row(f++) << v00, v11, v01;
+    }
+  return *CutSurface::triangles(X, F);
+}
+
+TEST(Cut3D, CurvedSurfaceFullCutSeparatesPiece) {
+  const TetMesh box = testing::boxTetMesh(6, 6, 6, 1.0 / 6);
+  // Cylinder of radius 0.5 around (0.5, y, 1.05): a scoop off the top, all the way through y.
+  const CutSurface s = cylinderStrip(Vec3(0.5, 0, 1.05), 0.5, M_PI * 0.95, M_PI * 2.05, -0.1, 1.1, 40, 4);
+  for (CutMethod method : {CutMethod::Hybrid, CutMethod::Standard, CutMethod::Snap, CutMethod::Delete}) {
+    SCOPED_TRACE(cutMethodName(method));
+    auto r = cut3d(box, s, withMethod(method));
+    ASSERT_TRUE(r.ok()) << r.error();
+    const auto v = validate(r->mesh);
+    EXPECT_TRUE(v.ok()) << v.error();
+    if (method != CutMethod::Delete) {
+      EXPECT_NEAR(totalVolume(r->mesh), 1.0, 1e-6);
+      EXPECT_EQ(components(r->mesh), 2);
+    }
+    // No tet has nodes clearly inside and clearly outside the cylinder (within the strip).
+    int straddling = 0;
+    for (int t = 0; t < r->mesh.numTets(); ++t) {
+      bool in = false, outside = false;
+      for (int k = 0; k < 4; ++k) {
+        const Vec3 x = r->mesh.X.row(r->mesh.T(t, k)).transpose();
+        const double d = std::hypot(x.x() - 0.5, x.z() - 1.05) - 0.5;
+        in = in || d < -1e-3;
+        outside = outside || d > 1e-3;
+      }
+      straddling += in && outside;
+    }
+    EXPECT_EQ(straddling, 0);
+  }
+}
+
+TEST(Cut3D, PartialCutStaysConnectedAndValid) {
+  const TetMesh box = testing::boxTetMesh(6, 6, 6, 1.0 / 6);
+  // A square patch in the middle of the box, slightly tilted: the cut ends inside.
+  Positions X(4, 3);
+  X << 0.2, 0.2, 0.52, 0.8, 0.2, 0.55, 0.8, 0.8, 0.53, 0.2, 0.8, 0.5;
+  Tris F(2, 3);
+  F << 0, 1, 2, 0, 2, 3;
+  const CutSurface s = *CutSurface::triangles(X, F);
+  for (CutMethod method : {CutMethod::Hybrid, CutMethod::Standard, CutMethod::Snap}) {
+    SCOPED_TRACE(cutMethodName(method));
+    auto r = cut3d(box, s, withMethod(method));
+    ASSERT_TRUE(r.ok()) << r.error();
+    const auto v = validate(r->mesh);
+    EXPECT_TRUE(v.ok()) << v.error();
+    EXPECT_NEAR(totalVolume(r->mesh), 1.0, 1e-9);
+    EXPECT_EQ(components(r->mesh), 1);
+    EXPECT_GT(r->report.cut_faces, 0);
+    EXPECT_GT(r->report.duplicated_nodes, 0);
+  }
+}
+
+TEST(Cut3D, SurfaceOnPlaneMatchesPlaneCut) {
+  const TetMesh box = testing::boxTetMesh(3, 3, 3, 1.0);
+  Positions X(4, 3);
+  X << -1, -1, 1.4, 4, -1, 1.4, 4, 4, 1.4, -1, 4, 1.4;
+  Tris F(2, 3);
+  F << 0, 1, 2, 0, 2, 3;
+  const CutSurface s = *CutSurface::triangles(X, F);
+  const CutSurface p = *CutSurface::plane(Vec3(0, 0, 1.4), Vec3(0, 0, 1));
+  for (CutMethod method : {CutMethod::Hybrid, CutMethod::Standard}) {
+    const auto a = cut3d(box, s, withMethod(method));
+    const auto b = cut3d(box, p, withMethod(method));
+    ASSERT_TRUE(a.ok() && b.ok());
+    EXPECT_EQ(a->mesh.numTets(), b->mesh.numTets());
+    EXPECT_EQ(a->mesh.numNodes(), b->mesh.numNodes());
+  }
+}
+
+TEST(Cut3D, BadInput) {
+  EXPECT_FALSE(CutSurface::plane(Vec3(0, 0, 0), Vec3(0, 0, 0)).ok());
+  Positions X(3, 3);
+  X << 0, 0, 0, 1, 0, 0, 2, 0, 0;
+  Tris F(1, 3);
+  F << 0, 1, 2;
+  EXPECT_FALSE(CutSurface::triangles(X, F).ok());  // degenerate only
+  F << 0, 1, 5;
+  EXPECT_FALSE(CutSurface::triangles(X, F).ok());
+  TetMesh empty;
+  EXPECT_FALSE(cut3d(empty, *CutSurface::plane(Vec3(0, 0, 0), Vec3(0, 0, 1))).ok());
+  TetMesh bad = singleTet();
+  bad.T(0, 3) = 7;
+  EXPECT_FALSE(cut3d(bad, *CutSurface::plane(Vec3(0, 0, 0), Vec3(0, 0, 1))).ok());
+}
+
+TEST(Cut3D, ComponentsFreeAndVolumes) {
+  const TetMesh box = testing::boxTetMesh(2, 2, 2, 1.0);
+  const auto r = cutAndCheck(box, Vec3(0, 0, 1), Vec3(0, 0, 1), withMethod(CutMethod::Hybrid));
+  const auto c = tetComponents(r.mesh, {0});  // node 0 (z = 0) anchored
+  ASSERT_EQ(c.count, 2);
+  EXPECT_NEAR(c.volume[0] + c.volume[1], 8.0, 1e-12);
+  EXPECT_NEAR(c.volume[0], 4.0, 1e-12);
+  EXPECT_EQ(static_cast<int>(c.free[0]) + static_cast<int>(c.free[1]), 1);
+  EXPECT_FALSE(c.free[c.label(r.mesh.numTets() > 0 ? 0 : 0)] && false);
+}
+
+TEST(Cut3D, UterusPlaneCutQuality) {
+  const std::string path = std::string(HYSIM_SOURCE_DIR) + "/assets/uterus_myoma.msh";
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << "no " << path;
+  const auto mesh = readTetMesh(path);
+  ASSERT_TRUE(mesh.ok()) << mesh.error();
+  const auto s0 = computeStats(*mesh);
+  const Vec3 lo = mesh->X.colwise().minCoeff().transpose(), hi = mesh->X.colwise().maxCoeff().transpose();
+  const Vec3 c = 0.5 * (lo + hi);
+  const auto h = cutAndCheck(*mesh, c, Vec3(0.2, 0.1, 1.0), withMethod(CutMethod::Hybrid), 1e-3);
+  const auto s1 = computeStats(h.mesh);
+  EXPECT_LE(s1.elements, 1.10 * s0.elements);
+  EXPECT_GE(s1.q_min, 0.25 * s0.q_min);
+  EXPECT_GE(s1.edge_min, 0.2 * s0.edge_min);
+  const auto st = cutAndCheck(*mesh, c, Vec3(0.2, 0.1, 1.0), withMethod(CutMethod::Standard), 1e-9);
+  EXPECT_GT(st.mesh.numTets(), h.mesh.numTets());
+}
+
+}  // namespace
+}  // namespace hysim::cutting
