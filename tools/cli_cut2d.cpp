@@ -11,8 +11,9 @@
 #include "hysim/cutting/cut2d.hpp"
 #include "hysim/cutting/mesh_io.hpp"
 #include "hysim/cutting/mesh_stats.hpp"
-#include "tables.hpp"
 #include "cli_cut3d.hpp"
+#include "tables.hpp"
+#include "tool_common.hpp"
 
 namespace hysim::tools {
 
@@ -84,19 +85,7 @@ int cutCommand(const Cut2dCommands& c) {
               res->mesh.numTris(), r.crossed_edges, r.displaced_nodes, r.subdivided_edges, r.edge_flips,
               r.collapsed_edges, r.duplicated_nodes, s.q_min, ms, r.optimize_ms);
   if (!c.stats.empty()) {
-    nlohmann::ordered_json j;
-    j["nodes"] = s.nodes;
-    j["elements"] = s.elements;
-    j["size_min"] = s.size_min;
-    j["size_mean"] = s.size_mean;
-    j["size_std"] = s.size_std;
-    j["edge_min"] = s.edge_min;
-    j["edge_mean"] = s.edge_mean;
-    j["edge_std"] = s.edge_std;
-    j["q_min"] = s.q_min;
-    j["q_mean"] = s.q_mean;
-    j["q_std"] = s.q_std;
-    j["dihedral_min_deg"] = s.dihedral_min_deg;
+    nlohmann::ordered_json j = tools::statsJson(s);
     j["time_ms"] = ms;
     j["optimize_ms"] = r.optimize_ms;
     j["method"] = cutting::cutMethodName(o.method);

@@ -1,6 +1,7 @@
 // The hysim command line, run as a user would: exit codes, messages, outputs.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
+
+#include "run_hysim.hpp"
 
 #include <array>
 #include <cstdio>
@@ -14,30 +15,11 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct Output {
-  int exit_code = -1;
-  std::string text;  // stdout and stderr
-};
+using hysim::testing::Output;
 
-Output hysim(const std::string& args) {
-  Output out;
-  const std::string cmd = std::string("cd ") + HYSIM_SOURCE_DIR + " && " + HYSIM_BINARY + " " + args + " 2>&1";
-  FILE* pipe = popen(cmd.c_str(), "r");
-  if (pipe == nullptr) return out;
-  std::array<char, 4096> buf;
-  size_t n;
-  while ((n = fread(buf.data(), 1, buf.size(), pipe)) > 0) out.text.append(buf.data(), n);
-  const int status = pclose(pipe);
-  out.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return out;
-}
+Output hysim(const std::string& args) { return hysim::testing::runHysim(args); }
 
-std::string outDir(const std::string& name) {
-  const fs::path p = fs::path(HYSIM_TEST_OUTPUT_DIR) / "cli" / name;
-  fs::remove_all(p);
-  fs::create_directories(p);
-  return p.string();
-}
+std::string outDir(const std::string& name) { return hysim::testing::freshOutputDir("cli", name); }
 
 TEST(Cli, HelpForEachSubcommand) {
   for (const char* sub : {"run", "stats"}) {
