@@ -1,0 +1,79 @@
+#include "hysim/engine/tool.hpp"
+
+#include <Eigen/Geometry>
+#include <cmath>
+
+namespace hysim::engine {
+
+void loopPoints(const LoopGeometry& loop, const haptics::ToolPose& pose, Eigen::Matrix<double, Eigen::Dynamic, 3>& out) {
+  const int n = loop.segments + 1;
+  if (out.rows() != n) out.resize(n, 3);
+  constexpr double kDeg = 3.14159265358979323846 / 180.0;
+  // Body frame: x = pose x, y = up, z = shaft axis. The loop's plane contains the body x axis
+  // and its in-plane "down" direction, tilted from -y towards +z when the loop is not
+  // perpendicular to the shaft.
+  const double tilt = (90.0 - loop.angle_deg) * kDeg;
+  const Eigen::Vector3d x_body(1, 0, 0);
+  const Eigen::Vector3d down_body(0, -std::cos(tilt), std::sin(tilt));
+  const Eigen::Vector3d centre_body(0, -loop.drop_mm, loop.reach_mm + pose.extension_mm);
+  const double half = 0.5 * loop.arc_deg * kDeg;
+  for (int i = 0; i < n; ++i) {
+    const double phi = -half + (2.0 * half) * i / loop.segments;
+    const Eigen::Vector3d p_body =
+        centre_body + loop.loop_radius_mm * (std::sin(phi) * x_body + std::cos(phi) * down_body);
+    out.row(i) = (pose.tip + pose.rotation * p_body).transpose();
+  }
+}
+
+void Sweep::clear() {
+  points_.clear();
+  row_size_ = 0;
+  num_rows_ = 0;
+  num_quads_ = 0;
+  path_length_ = 0.0;
+}
+
+void Sweep::advance(const Eigen::Matrix<double, Eigen::Dynamic, 3>& wire) {
+  const int n = static_cast<int>(wire.rows());
+  if (num_rows_ > 0 && n != row_size_) clear();  // a different loop: start over
+  if (num_rows_ > 0) {
+    const int mid = n / 2;
+    path_length_ += (wire.row(mid).transpose() - points_[(num_rows_ - 1) * row_size_ + mid]).norm();
+    num_quads_ += n - 1;
+  }
+  row_size_ = n;
+  for (int i = 0; i < n; ++i) points_.push_back(wire.row(i).transpose());
+  ++num_rows_;
+}
+
+Eigen::Matrix<double, Eigen::Dynamic, 3> Sweep::vertices() const {
+  Eigen::Matrix<double, Eigen::Dynamic, 3> v(static_cast<Eigen::Index>(points_.size()), 3);
+  for (size_t i = 0; i < points_.size(); ++i) v.row(static_cast<Eigen::Index>(i)) = points_[i].transpose();
+  return v;
+}
+
+Eigen::Matrix<int, Eigen::Dynamic, 3> Sweep::triangles() const {
+  Eigen::Matrix<int, Eigen::Dynamic, 3> f(2 * num_quads_, 3);
+  int t = 0;
+  for (int r = 0; r + 1 < num_rows_; ++r) {
+    for (int i = 0; i + 1 < row_size_; ++i) {
+      const int a = r * row_size_ + i, b = a + 1, c = a + row_size_, d = c + 1;
+      f.row(t++) << a, b, d;
+      f.row(t++) << a, d, c;
+    }
+  }
+  return f;
+}
+
+double Sweep::area() const {
+  const auto v = vertices();
+  const auto f = triangles();
+  double total = 0.0;
+  for (int t = 0; t < f.rows(); ++t) {
+    const Eigen::Vector3d a = v.row(f(t, 0)), b = v.row(f(t, 1)), c = v.row(f(t, 2));
+    total += 0.5 * (b - a).cross(c - a).norm();
+  }
+  return total;
+}
+
+}  // namespace hysim::engine
