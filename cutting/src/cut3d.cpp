@@ -11,11 +11,10 @@
 #include <unordered_set>
 
 #include "hysim/cutting/mesh_stats.hpp"
+#include "optimize3d_internal.hpp"
 
 namespace hysim::cutting {
 
-void optimizeAfterCut3D(TetMesh& mesh, const std::vector<std::int32_t>& cut_nodes, const Optimize3DOptions& options,
-                        std::vector<std::int32_t>* moved, int* iterations);  // optimize3d.cpp
 
 namespace {
 
@@ -384,6 +383,55 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
     }
   }
 
+  // 2b. Hybrid: a crossing still within through_node_fraction * |e| of an end node that could
+  //     not be snapped (feature/boundary node, refused move) would leave a tiny edge and
+  //     slivers. The cut passes through that node instead: it is treated as lying on the
+  //     surface and its crossed edges are not split. The cut surface is then approximated
+  //     locally, off by at most through_node_fraction * |e| (measured along the edge).
+  std::vector<std::uint8_t> approx;  // nodes treated as on the surface without moving
+  if (options.method == CutMethod::Hybrid && options.through_node_fraction > 0 && !crossed.empty()) {
+    struct Near {
+      double frac;
+      std::int32_t node, edge;
+    };
+    std::vector<Near> near;
+    for (int e = 0; e < static_cast<int>(crossed.size()); ++e) {
+      const auto& c = crossed[e];
+      if (!c.alive) continue;
+      if (c.t < options.through_node_fraction) near.push_back({c.t, c.a, e});
+      if (1.0 - c.t < options.through_node_fraction) near.push_back({1.0 - c.t, c.b, e});
+    }
+    std::stable_sort(near.begin(), near.end(), [](const Near& x, const Near& y) { return x.frac < y.frac; });
+    for (const auto& nr : near) {
+      const int n = nr.node;
+      if (on[n] || !crossed[nr.edge].alive) continue;
+      if (approx.empty()) approx.assign(N0, 0);
+      approx[n] = 1;
+      on[n] = 1;
+      onNodes.push_back(n);
+      ++report.through_nodes;
+      for (int s = starOff[n]; s < starOff[n + 1]; ++s) {
+        const Tet tv = w.tet(starTet[s]);
+        for (int k = 0; k < 4; ++k) {
+          if (tv[k] == n) continue;
+          // Edges crossed nearer n than their other end now end on the cut; the others
+          // (crossed nearer the other end, which may itself be routed through) stay split.
+          const auto it = edgeIndex.find(edgeKey(n, tv[k]));
+          if (it == edgeIndex.end()) continue;
+          CrossedEdge& ce = crossed[it->second];
+          if ((ce.a == n ? ce.t : 1.0 - ce.t) <= 0.5) ce.alive = false;
+        }
+      }
+    }
+    // Two routed nodes on opposite sides: their edge is split after all (else one tet would
+    // hold both), unless the crossing is too near one of them.
+    if (!approx.empty())
+      for (auto& ce : crossed)
+        if (!ce.alive && approx[ce.a] && approx[ce.b] && ce.t >= options.through_node_fraction &&
+            1.0 - ce.t >= options.through_node_fraction)
+          ce.alive = true;
+  }
+
   // 3. Subdivision: split every edge still crossed (conforming bisection of the tets around
   //    it), or, for deletion, remove the crossed tets.
   std::vector<std::int32_t> localOf(M0, -1);   // original tet -> index into fragments
@@ -479,8 +527,25 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
   }
   std::unordered_set<FaceKey, FaceKeyHash> cutFaces;
   std::vector<std::pair<std::int32_t, std::int8_t>> cutFaceSides;  // (tet, opposite local vertex)
+  // Side of a tet at a face on the cut: the signed distance of the vertex opposite the face
+  // (a node treated as on the surface without moving keeps its own small distance).
+  // Side of a tet: the sign of the distances of its nodes off the cut (all alike after the
+  // subdivision); when every node is on the cut, of the nodes the cut was routed through.
+  auto sideOf = [&](int t, int) {
+    const Tet tv = w.tet(t);
+    double off = 0, routed = 0;
+    for (int v : tv) {
+      if (v >= N0 || (on[v] && !approx[v])) continue;
+      const double d = plane ? phi[v] : surface.signedDistance(w.x(v));
+      (on[v] ? routed : off) += d;
+    }
+    return off != 0 ? off : routed;
+  };
   for (const auto& [key, use] : onFaces) {
     if (use.count != 2) continue;
+    // Only a face between the two sides is cut (with through-node approximation, a face of
+    // on-nodes may have both its tets on one side).
+    if (!approx.empty() && !(sideOf(use.tet[0], use.opposite[0]) * sideOf(use.tet[1], use.opposite[1]) < 0)) continue;
     if (!plane) {
       // The face must lie in the surface, not just have its corners on it.
       const Vec3 a = w.x(key.v[0]), b = w.x(key.v[1]), c = w.x(key.v[2]);
@@ -605,9 +670,66 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
   std::sort(change.added_elements.begin(), change.added_elements.end());
 
   // 5. Local optimisation (hybrid).
-  if (options.method == CutMethod::Hybrid && options.optimize.enabled && !cutNodes.empty()) {
+  if (options.method == CutMethod::Hybrid && options.optimize.enabled && !cutNodes.empty() &&
+      options.optimize.rings > 0) {
     const auto optStart = std::chrono::steady_clock::now();
-    optimizeAfterCut3D(out, cutNodes, options.optimize, &moved, &report.optimize_iterations);
+    // Stars of the nodes up to `rings` edge steps from the cut, from the input's node -> tet
+    // lists and the fragments of the split tets (only what the cut touched).
+    LocalStars stars;
+    std::vector<std::int32_t> star;
+    auto starOf = [&](int n) {  // n < N0 and not on the cut, so never renumbered
+      star.clear();
+      for (int s = starOff[n]; s < starOff[n + 1]; ++s) {
+        const int o = starTet[s];
+        if (localOf[o] < 0) {
+          star.push_back(o);
+        } else {
+          for (int f : fragments[localOf[o]])
+            if (out.T(f, 0) == n || out.T(f, 1) == n || out.T(f, 2) == n || out.T(f, 3) == n) star.push_back(f);
+        }
+      }
+    };
+    auto boundaryStar = [&](int n) {
+      std::vector<FaceKey> faces;
+      for (int t : star)
+        for (int f = 0; f < 4; ++f) {
+          const FaceKey k = makeFace(out.T(t, kFace[f][0]), out.T(t, kFace[f][1]), out.T(t, kFace[f][2]));
+          if (k.v[0] != n && k.v[1] != n && k.v[2] != n) continue;
+          const auto it = std::find(faces.begin(), faces.end(), k);
+          if (it == faces.end()) {
+            faces.push_back(k);
+          } else {
+            faces.erase(it);
+          }
+        }
+      return !faces.empty();
+    };
+    std::unordered_set<std::int32_t> seen(cutNodes.begin(), cutNodes.end());
+    std::vector<std::int32_t> frontier;
+    for (int t : local)
+      for (int k = 0; k < 4; ++k) {
+        const int v = out.T(t, k);
+        if (v < N0 && !on[v] && seen.insert(v).second) frontier.push_back(v);
+      }
+    stars.offset.push_back(0);
+    for (int ring = 1; ring <= options.optimize.rings && !frontier.empty(); ++ring) {
+      std::vector<std::int32_t> next;
+      for (int n : frontier) {
+        starOf(n);
+        if (ring < options.optimize.rings)
+          for (int t : star)
+            for (int k = 0; k < 4; ++k) {
+              const int v = out.T(t, k);
+              if (v < N0 && !on[v] && seen.insert(v).second) next.push_back(v);
+            }
+        if (boundaryStar(n)) continue;
+        stars.nodes.push_back(n);
+        stars.tets.insert(stars.tets.end(), star.begin(), star.end());
+        stars.offset.push_back(static_cast<std::int32_t>(stars.tets.size()));
+      }
+      frontier.swap(next);
+    }
+    optimizeLocal3D(out, stars, options.optimize, &moved, &report.optimize_iterations);
     report.optimize_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - optStart).count();
   }
   std::sort(moved.begin(), moved.end());
