@@ -5,6 +5,7 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <numeric>
 #include <string>
 #include <unordered_map>
@@ -237,6 +238,104 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
   const bool deleting = options.method == CutMethod::Delete;
   std::vector<std::uint8_t> deleted;
 
+  // Moving node n to `target` keeps every tet of its star positive, not flat and not badly
+  // degraded (q* below min(before, min_quality)), and every edge of n at least
+  // min_edge_fraction of its length.
+  auto guardOk = [&](int n, const Vec3& target) {
+    const Vec3 old = w.x(n);
+    for (int s = starOff[n]; s < starOff[n + 1]; ++s) {
+      const Tet tv = w.tet(starTet[s]);
+      Vec3 p[4], q[4];
+      for (int k = 0; k < 4; ++k) {
+        p[k] = w.x(tv[k]);
+        q[k] = tv[k] == n ? target : p[k];
+      }
+      const double v0 = signedVolume(p[0], p[1], p[2], p[3]);
+      const double v1 = signedVolume(q[0], q[1], q[2], q[3]);
+      if (!(v1 > 1e-3 * v0)) return false;
+      const double qa = radiusRatio(q[0], q[1], q[2], q[3]);
+      if (qa < options.min_quality && qa < radiusRatio(p[0], p[1], p[2], p[3])) return false;
+      for (int k = 0; k < 4; ++k) {
+        if (tv[k] == n) continue;
+        if ((q[k] - target).norm() < options.min_edge_fraction * (p[k] - old).norm()) return false;
+      }
+    }
+    return true;
+  };
+  const double cosFeature = std::cos(options.feature_angle_deg * M_PI / 180.0);
+  // Boundary faces around n (faces with n used by one tet of its star): the other two nodes
+  // and the unit normal.
+  struct BFace {
+    std::int32_t u, v;
+    Vec3 normal;
+  };
+  auto boundaryFacesOf = [&](int n) {
+    std::vector<std::pair<FaceKey, Vec3>> faces;
+    std::vector<int> count;
+    for (int s = starOff[n]; s < starOff[n + 1]; ++s) {
+      const Tet tv = w.tet(starTet[s]);
+      const int ln = findLocal(tv, n);
+      for (int f = 0; f < 4; ++f) {
+        if (f == ln) continue;
+        const int i0 = tv[kFace[f][0]], i1 = tv[kFace[f][1]], i2 = tv[kFace[f][2]];
+        const FaceKey key = makeFace(i0, i1, i2);
+        bool found = false;
+        for (size_t q = 0; q < faces.size(); ++q)
+          if (faces[q].first == key) {
+            ++count[q];
+            found = true;
+          }
+        if (!found) {
+          faces.emplace_back(key, (w.x(i1) - w.x(i0)).cross(w.x(i2) - w.x(i0)));
+          count.push_back(1);
+        }
+      }
+    }
+    std::vector<BFace> out;
+    for (size_t q = 0; q < faces.size(); ++q) {
+      if (count[q] != 1) continue;
+      std::int32_t o[2], m = 0;
+      for (int v : faces[q].first.v)
+        if (v != n) o[m++] = v;
+      out.push_back({o[0], o[1], faces[q].second.normalized()});
+    }
+    return out;
+  };
+  // Feature edges of a boundary node: boundary edges whose two faces meet at more than the
+  // feature angle. `straight`: exactly two, nearly straight through n (a ridge node); a node
+  // may slide along its feature edges and stays on the feature lines (a corner or a bent
+  // ridge only a short way: feature_slide_fraction of the edge, 0 = never). Non-manifold: none.
+  struct FeatureEdges {
+    std::vector<std::int32_t> to;
+    bool straight = false;
+  };
+  auto featureEdgesOf = [&](int n) {
+    FeatureEdges fe;
+    const auto bf = boundaryFacesOf(n);
+    std::vector<std::pair<std::int32_t, std::vector<Vec3>>> edges;
+    auto add = [&](std::int32_t v, const Vec3& nrm) {
+      for (auto& e : edges)
+        if (e.first == v) {
+          e.second.push_back(nrm);
+          return;
+        }
+      edges.push_back({v, {nrm}});
+    };
+    for (const auto& f : bf) {
+      add(f.u, f.normal);
+      add(f.v, f.normal);
+    }
+    for (const auto& e : edges) {
+      if (e.second.size() != 2) return FeatureEdges{};
+      if (e.second[0].dot(e.second[1]) < cosFeature) fe.to.push_back(e.first);
+    }
+    if (fe.to.size() == 2) {
+      const Vec3 d0 = (w.x(fe.to[0]) - w.x(n)).normalized(), d1 = (w.x(fe.to[1]) - w.x(n)).normalized();
+      fe.straight = d0.dot(d1) < -cosFeature;
+    }
+    return fe;
+  };
+
   // 2. Snapping (hybrid / snap only).
   const double region = options.method == CutMethod::Hybrid ? options.snap_region
                         : options.method == CutMethod::Snap ? 0.5
@@ -254,7 +353,6 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
     }
     std::stable_sort(candidates.begin(), candidates.end(),
                      [](const Candidate& x, const Candidate& y) { return x.frac < y.frac; });
-    const double cosFeature = std::cos(options.feature_angle_deg * M_PI / 180.0);
     std::vector<std::uint8_t> refused(N0, 0);
     for (const auto& cand : candidates) {
       const int n = cand.node;
@@ -296,15 +394,33 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
         if (v[0] == other || v[1] == other || v[2] == other) boundaryEdge = true;
       }
       Vec3 target;
+      bool ridgeSnap = false;
       if (boundary) {
         // Boundary nodes stay within the boundary: only where it is flat around them (no
         // feature edge or corner), sliding along the crossed boundary edge, or else within
         // the boundary's tangent plane onto the cut.
         if (feature) {
-          ++report.feature_skips;
-          continue;
-        }
-        if (boundaryEdge) {
+          // A ridge node slides along a crossed ridge edge (it stays on the feature line).
+          bool slid = false;
+          if (options.method == CutMethod::Hybrid) {
+            const auto fe = featureEdgesOf(n);
+            const double reach = fe.straight ? region : std::min(region, options.feature_slide_fraction);
+            for (int r : fe.to) {
+              const auto it = edgeIndex.find(edgeKey(n, r));
+              if (it == edgeIndex.end()) continue;
+              const CrossedEdge& re = crossed[it->second];
+              if (!re.alive || (re.a == n ? re.t : 1.0 - re.t) > reach) continue;
+              target = crossingPoint(re);
+              slid = true;
+              break;
+            }
+          }
+          if (!slid) {
+            ++report.feature_skips;
+            continue;
+          }
+          ridgeSnap = true;
+        } else if (boundaryEdge) {
           target = crossingPoint(ce);
         } else {
           Vec3 m = Vec3::Zero();
@@ -334,31 +450,10 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
       }
       // Guard: no inverted, flat or badly degraded tet; no collapsed edge. An interior node
       // refused at the nearest point of the cut tries the crossing on its edge instead.
-      const Vec3 old = w.x(n);
       bool ok = false;
       for (int attempt = 0; attempt < (boundary ? 1 : 2) && !ok; ++attempt) {
-      if (attempt == 1) target = crossingPoint(ce);
-      ok = true;
-      for (int s = starOff[n]; s < starOff[n + 1] && ok; ++s) {
-        const Tet tv = w.tet(starTet[s]);
-        Vec3 p[4], q[4];
-        for (int k = 0; k < 4; ++k) {
-          p[k] = w.x(tv[k]);
-          q[k] = tv[k] == n ? target : p[k];
-        }
-        const double v0 = signedVolume(p[0], p[1], p[2], p[3]);
-        const double v1 = signedVolume(q[0], q[1], q[2], q[3]);
-        if (!(v1 > 1e-3 * v0)) {
-          ok = false;
-          break;
-        }
-        const double qa = radiusRatio(q[0], q[1], q[2], q[3]);
-        if (qa < options.min_quality && qa < radiusRatio(p[0], p[1], p[2], p[3])) ok = false;
-        for (int k = 0; k < 4 && ok; ++k) {
-          if (tv[k] == n) continue;
-          if ((q[k] - target).norm() < options.min_edge_fraction * (p[k] - old).norm()) ok = false;
-        }
-      }
+        if (attempt == 1) target = crossingPoint(ce);
+        ok = guardOk(n, target);
       }
       if (!ok) {
         if (!refused[n]) ++report.refused_snaps;
@@ -372,6 +467,7 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
       moved.push_back(n);
       ++report.snapped_nodes;
       if (boundary) ++report.boundary_snaps;
+      if (ridgeSnap) ++report.ridge_snaps;
       for (int s = starOff[n]; s < starOff[n + 1]; ++s) {
         const Tet tv = w.tet(starTet[s]);
         for (int k = 0; k < 4; ++k) {
@@ -379,6 +475,107 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
           const auto it = edgeIndex.find(edgeKey(n, tv[k]));
           if (it != edgeIndex.end()) crossed[it->second].alive = false;
         }
+      }
+    }
+  }
+
+  // 2a. Hybrid, plane: a node not on the cut whose crossed edges are still cut within
+  //     away_fraction * |e| of it would leave tiny edges and slivers after the split. It moves
+  //     away from the plane instead (interior: along the normal; flat boundary: within its
+  //     tangent plane; ridge: along a ridge edge), just far enough that every crossing on its
+  //     edges lies at >= away_fraction of the edge; if the guard refuses, at 3/4 or 1/2 of that.
+  //     The cut stays exactly the plane: only the crossings move along their edges.
+  if (options.method == CutMethod::Hybrid && plane && options.away_fraction > 0 && !crossed.empty()) {
+    const double f = std::min(options.away_fraction, 0.45);
+    const Vec3 pn = surface.planeNormal().normalized(), pp = surface.planePoint();
+    struct Near {
+      double frac;
+      std::int32_t node;
+    };
+    std::vector<Near> near;
+    for (const auto& c : crossed) {
+      if (!c.alive) continue;
+      if (c.t < f) near.push_back({c.t, c.a});
+      if (1.0 - c.t < f) near.push_back({1.0 - c.t, c.b});
+    }
+    std::stable_sort(near.begin(), near.end(), [](const Near& x, const Near& y) { return x.frac < y.frac; });
+    std::vector<std::uint8_t> tried(N0, 0);
+    for (const auto& nr : near) {
+      const int n = nr.node;
+      if (on[n] || tried[n]) continue;
+      tried[n] = 1;
+      // |phi| that puts every crossing on n's edges at >= f of the edge.
+      double need = 0;
+      for (int s = starOff[n]; s < starOff[n + 1]; ++s) {
+        const Tet tv = w.tet(starTet[s]);
+        for (int k = 0; k < 4; ++k) {
+          if (tv[k] == n) continue;
+          const auto it = edgeIndex.find(edgeKey(n, tv[k]));
+          if (it == edgeIndex.end() || !crossed[it->second].alive) continue;
+          need = std::max(need, f / (1.0 - f) * std::abs(phi[tv[k]]));
+        }
+      }
+      const double sgn = phi[n] > 0 ? 1.0 : -1.0;
+      const double have = std::abs(phi[n]);
+      if (!(need > have)) continue;
+      // Direction (unit) and the rate at which |phi| grows along it.
+      Vec3 dir;
+      double rate, maxStep = std::numeric_limits<double>::infinity();
+      const auto bf = boundaryFacesOf(n);
+      if (bf.empty()) {
+        dir = sgn * pn;
+        rate = 1.0;
+      } else {
+        bool feature = false;
+        Vec3 m = Vec3::Zero();
+        for (const auto& b : bf) {
+          if (b.normal.dot(bf[0].normal) < cosFeature) feature = true;
+          m += b.normal;
+        }
+        if (!feature) {
+          m.normalize();
+          const Vec3 d = pn - pn.dot(m) * m;  // steepest direction within the tangent plane
+          rate = d.norm();
+          if (!(rate > 0.25)) continue;  // plane nearly parallel to the boundary there
+          dir = sgn * d / rate;
+        } else {
+          // Along the ridge edge on which |phi| grows fastest, at most half of it.
+          rate = 0;
+          const auto fe = featureEdgesOf(n);
+          for (int r : fe.to) {
+            const Vec3 e = w.x(r) - w.x(n);
+            const double len = e.norm();
+            const double g = sgn * (phi[r] - phi[n]) / len;
+            if (on[r] || !(g > rate)) continue;
+            rate = g;
+            dir = e / len;
+            maxStep = (fe.straight ? 0.5 : options.feature_slide_fraction) * len;
+          }
+          if (!(rate > 0.25)) continue;
+        }
+      }
+      for (const double level : {1.0, 0.75, 0.5, 0.35, 0.25}) {
+        const double want = level * need;
+        if (!(want > have)) break;
+        const double step = (want - have) / rate;
+        if (step > maxStep) continue;
+        const Vec3 target = w.x(n) + step * dir;
+        if (!guardOk(n, target)) continue;
+        w.X0.row(n) = target.transpose();
+        phi[n] = pn.dot(target - pp);
+        for (int s = starOff[n]; s < starOff[n + 1]; ++s) {
+          const Tet tv = w.tet(starTet[s]);
+          for (int k = 0; k < 4; ++k) {
+            if (tv[k] == n) continue;
+            const auto it = edgeIndex.find(edgeKey(n, tv[k]));
+            if (it == edgeIndex.end()) continue;
+            CrossedEdge& ce = crossed[it->second];
+            ce.t = phi[ce.a] / (phi[ce.a] - phi[ce.b]);
+          }
+        }
+        moved.push_back(n);
+        ++report.away_moves;
+        break;
       }
     }
   }
@@ -729,7 +926,9 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
       }
       frontier.swap(next);
     }
+    const size_t before = moved.size();
     optimizeLocal3D(out, stars, options.optimize, &moved, &report.optimize_iterations);
+    report.optimized_nodes = static_cast<int>(moved.size() - before);
     report.optimize_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - optStart).count();
   }
   std::sort(moved.begin(), moved.end());
@@ -737,7 +936,6 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
   // Only surviving old nodes count as moved (new ones are described by new_nodes).
   for (int n : moved)
     if (n < N0) change.moved_nodes.push_back(n);
-  report.optimized_nodes = static_cast<int>(moved.size()) - report.snapped_nodes;
   change.cut_nodes = cutNodes;
 
   if (deleting) {

@@ -148,10 +148,12 @@ TEST(Cut3D, HybridNearNodesSnapsInsteadOfSubdividing) {
   o.optimize.enabled = false;
   const auto r = cutAndCheck(box, Vec3(0, 0, 1.1), Vec3(0, 0, 1), o);
   // The interior node and the four face-centre nodes at z = 1 slide up; the four nodes on the
-  // box's vertical edges are features and stay, so their edges are subdivided.
-  EXPECT_EQ(r.report.snapped_nodes, 5);
-  EXPECT_EQ(r.report.boundary_snaps, 4);
-  EXPECT_GT(r.report.refused_snaps + r.report.split_edges, 0);
+  // box's vertical edges are on straight ridges and slide up along them (still on the ridge,
+  // volume exact), so nothing is subdivided.
+  EXPECT_EQ(r.report.snapped_nodes, 9);
+  EXPECT_EQ(r.report.boundary_snaps, 8);
+  EXPECT_EQ(r.report.ridge_snaps, 4);
+  EXPECT_EQ(r.report.split_edges, 0);
   EXPECT_EQ(components(r.mesh), 2);
   // Tets whose three nodes were snapped have a face in the cut: three nodes separated.
   EXPECT_GT(r.report.cut_faces, 0);
