@@ -6,9 +6,12 @@
 // topology change.
 //
 // Cost on the default mesh (26k faces, AABB tree; ./build/bench/bench_collision): refit
-// ~0.9 ms, a touching query ~0.7 ms (OBBRSS refits took ~49 ms). Too slow for every 1 ms
-// step as it stands: the shaving loop will have to refit less often with a margin, or
-// restrict the hierarchy to the region the loop can reach.
+// ~0.9 ms, a touching query ~0.7 ms. Callgrind shows why the query is slow: for a
+// non-oriented BV (AABB), FCL 0.7's shape-vs-mesh collide copies the BVHModel and rebuilds
+// its tree on every call (BVHModel copy + recursiveBuildTree dominate). Oriented BVs
+// (OBBRSS) avoid the copy but their refit took ~49 ms. Too slow for every 1 ms step as it
+// stands; the shaving loop needs a broadphase that updates incrementally (e.g. FCL's
+// dynamic AABB tree over tets with fat boxes) or a hierarchy limited to the reachable region.
 #include <Eigen/Core>
 #include <memory>
 
