@@ -111,7 +111,29 @@ struct Panel {
   bool reset_requested = false;
   int lens_index = 2;  // 0, 12, 30 degrees
   float speed = 1.0f;
+  bool manual = false;  // keyboard drives the scope instead of the scripted path
+  bool manual_requested = false;
+  bool pedal = false;
 };
+
+// Keyboard -> rate command for the manual device: W/S forward/back along the axis,
+// arrows left/right/up/down (strafe), A/D yaw, PageUp/PageDown pitch, Q/E retract/extend
+// the loop.
+haptics::ManualCommand keyboardCommand(bool pedal) {
+  const Uint8* k = SDL_GetKeyboardState(nullptr);
+  constexpr double kSpeed = 10.0;   // mm/s
+  constexpr double kTurn = 0.6;     // rad/s
+  constexpr double kExtend = 5.0;   // mm/s
+  haptics::ManualCommand c;
+  c.velocity_scope_mm_s.z() = kSpeed * ((k[SDL_SCANCODE_W] ? 1 : 0) - (k[SDL_SCANCODE_S] ? 1 : 0));
+  c.velocity_scope_mm_s.x() = kSpeed * ((k[SDL_SCANCODE_RIGHT] ? 1 : 0) - (k[SDL_SCANCODE_LEFT] ? 1 : 0));
+  c.velocity_scope_mm_s.y() = kSpeed * ((k[SDL_SCANCODE_UP] ? 1 : 0) - (k[SDL_SCANCODE_DOWN] ? 1 : 0));
+  c.yaw_rad_s = kTurn * ((k[SDL_SCANCODE_A] ? 1 : 0) - (k[SDL_SCANCODE_D] ? 1 : 0));
+  c.pitch_rad_s = kTurn * ((k[SDL_SCANCODE_PAGEDOWN] ? 1 : 0) - (k[SDL_SCANCODE_PAGEUP] ? 1 : 0));
+  c.extension_mm_s = kExtend * ((k[SDL_SCANCODE_E] ? 1 : 0) - (k[SDL_SCANCODE_Q] ? 1 : 0));
+  c.pedal = pedal;
+  return c;
+}
 
 constexpr std::array<int, 3> kLens = {0, 12, 30};
 
@@ -157,6 +179,8 @@ int runApp(const AppArgs& args) {
   double realtime = 0.0;   // smoothed simulated seconds per wall second
   const double path_end_s = haptics::Trajectory(scene->tool_path).duration();
 
+  haptics::ManualDevice* manual_device = nullptr;  // owned by the simulation while in use
+
   const Clock::time_point start = Clock::now();
   Clock::time_point last = start;
   long frame = 0;
@@ -178,6 +202,7 @@ int runApp(const AppArgs& args) {
           case SDLK_SPACE: panel.paused = !panel.paused; break;
           case SDLK_r: panel.reset_requested = true; break;
           case SDLK_l: panel.lens_index = (panel.lens_index + 1) % 3; break;
+          case SDLK_m: panel.manual_requested = true; break;
           default: break;
         }
       }
@@ -194,10 +219,26 @@ int runApp(const AppArgs& args) {
       auto fresh = engine::Simulation::create(*scene);
       if (!fresh.ok()) return fail("reset: " + fresh.error());
       sim = std::move(fresh.value());
+      manual_device = nullptr;  // the fresh simulation follows the script again
+      panel.manual = false;
       pacer.reset();
       step_times.clear();
       max_force_n = 0.0;
     }
+
+    // Manual control: a keyboard device takes over from the current pose (M toggles).
+    if (panel.manual_requested) {
+      panel.manual_requested = false;
+      panel.manual = !panel.manual;
+      if (panel.manual) {
+        manual_device = new haptics::ManualDevice(sim->toolPose(), sim->state().time);
+        sim->setDevice(std::unique_ptr<haptics::Device>(manual_device));
+      } else {
+        manual_device = nullptr;
+        sim->setDevice(std::make_unique<haptics::ScriptedDevice>(haptics::Trajectory(scene->tool_path)));
+      }
+    }
+    if (manual_device != nullptr) manual_device->setCommand(keyboardCommand(panel.pedal));
 
     // Fixed steps due for the wall time since the last frame.
     const double sim_before = sim->state().time;
@@ -272,7 +313,7 @@ int runApp(const AppArgs& args) {
     } else {
       ImGui::Text("warnings     %8d", st.warnings);
     }
-    ImGui::Text("tool path    %s", st.time < path_end_s ? "scripted" : "done (holding last pose)");
+    ImGui::Text("tool path    %s", panel.manual ? "manual (keyboard)" : st.time < path_end_s ? "scripted" : "done (holding last pose)");
     ImGui::Separator();
     if (ImGui::Button(panel.paused ? "Resume (Space)" : "Pause (Space)", ImVec2(-1, 0))) {
       panel.paused = !panel.paused;
@@ -287,7 +328,17 @@ int runApp(const AppArgs& args) {
       ImGui::RadioButton(label, &panel.lens_index, i);
     }
     ImGui::Separator();
-    ImGui::TextDisabled("scope follows the scene's scripted path");
+    if (ImGui::Checkbox("manual scope (M)", &panel.manual)) {
+      panel.manual = !panel.manual;  // applied (and toggled) at the top of the next frame
+      panel.manual_requested = true;
+    }
+    if (panel.manual) {
+      ImGui::TextDisabled("W/S forward/back, arrows move");
+      ImGui::TextDisabled("A/D yaw, PgUp/PgDn pitch");
+      ImGui::TextDisabled("Q/E loop in/out");
+    } else {
+      ImGui::TextDisabled("scope follows the scene's scripted path");
+    }
     ImGui::TextDisabled("Esc: quit");
     ImGui::End();
     (*layer)->render();

@@ -62,3 +62,33 @@ TEST(ScriptedDevice, VelocityPedalAndForce) {
 
 }  // namespace
 }  // namespace hysim::haptics
+
+namespace hysim::haptics {
+namespace {
+
+TEST(ManualDevice, IntegratesRateCommandsInTheScopeFrame) {
+  ToolPose start;
+  start.tip = {0, 0, -20};
+  start.rotation = frameFromAxisUp({0, 0, 1}, {0, 1, 0});
+  ManualDevice device(start, 1.0);
+  ManualCommand forward;
+  forward.velocity_scope_mm_s = {0, 0, 10};  // along the axis
+  forward.extension_mm_s = 2.0;
+  device.setCommand(forward);
+  DeviceState s = device.read(1.5);
+  EXPECT_NEAR(s.pose.tip.z(), -15.0, 1e-12);
+  EXPECT_NEAR(s.pose.extension_mm, 1.0, 1e-12);
+  ManualCommand turn;
+  turn.yaw_rad_s = 3.14159265358979323846 / 2;  // 90 degrees in 1 s about up (+y)
+  device.setCommand(turn);
+  s = device.read(2.5);
+  EXPECT_NEAR(s.pose.rotation.col(2).x(), 1.0, 1e-9);  // the axis now points along +x
+  EXPECT_NEAR(s.pose.tip.z(), -15.0, 1e-12);           // turning does not move the tip
+  EXPECT_NEAR((s.pose.rotation.transpose() * s.pose.rotation - Eigen::Matrix3d::Identity()).norm(), 0.0, 1e-12);
+  // Reading the same time again changes nothing; time never runs backwards.
+  const DeviceState again = device.read(2.0);
+  EXPECT_EQ(again.pose.tip, s.pose.tip);
+}
+
+}  // namespace
+}  // namespace hysim::haptics

@@ -31,6 +31,8 @@ class Simulation {
   const sim::State& state() const { return state_; }
   const haptics::ToolPose& toolPose() const { return pose_; }
   const haptics::Device& device() const { return *device_; }
+  // Replaces the device that drives the tool (e.g. a keyboard device in the trainee app).
+  void setDevice(std::unique_ptr<haptics::Device> device) { device_ = std::move(device); }
   int numAnchored() const { return num_anchored_; }
   int numDeformableTets() const { return num_deformable_tets_; }  // tets with at least one free node
   int numSurfaceNodes() const { return static_cast<int>(surface_nodes_.size()); }

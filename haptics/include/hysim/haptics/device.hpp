@@ -64,4 +64,35 @@ class ScriptedDevice final : public Device {
   Eigen::Vector3d last_force_{0, 0, 0};
 };
 
+// A device driven by rate commands (keyboard, gamepad): the tip moves with a velocity given
+// in the scope's own frame, the scope turns (yaw about up, pitch about its x axis), the loop
+// extends or retracts. read(t) integrates the current command from the last read up to t,
+// so the same command stream gives the same path.
+struct ManualCommand {
+  Eigen::Vector3d velocity_scope_mm_s{0, 0, 0};  // x: right, y: up, z: forward (along the axis)
+  double yaw_rad_s = 0.0;                         // about the scope's up direction
+  double pitch_rad_s = 0.0;                       // about the scope's x direction
+  double extension_mm_s = 0.0;
+  bool pedal = false;
+};
+
+class ManualDevice final : public Device {
+ public:
+  ManualDevice(const ToolPose& start, double start_time_s, DeviceInfo info = defaultInfo());
+  static DeviceInfo defaultInfo();
+
+  void setCommand(const ManualCommand& command) { command_ = command; }
+  const DeviceInfo& info() const override { return info_; }
+  DeviceState read(double time_s) override;
+  void commandForce(const Eigen::Vector3d& force_n) override { last_force_ = safeForce(force_n, info_.max_force_n); }
+  const Eigen::Vector3d& lastForce() const override { return last_force_; }
+
+ private:
+  ToolPose pose_;
+  double time_s_;
+  ManualCommand command_;
+  DeviceInfo info_;
+  Eigen::Vector3d last_force_{0, 0, 0};
+};
+
 }  // namespace hysim::haptics
