@@ -308,6 +308,7 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
   struct FeatureEdges {
     std::vector<std::int32_t> to;
     bool straight = false;
+    bool polyhedral = false;  // all boundary faces around n in coplanar groups
   };
   auto featureEdgesOf = [&](int n) {
     FeatureEdges fe;
@@ -332,6 +333,20 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
     if (fe.to.size() == 2) {
       const Vec3 d0 = (w.x(fe.to[0]) - w.x(n)).normalized(), d1 = (w.x(fe.to[1]) - w.x(n)).normalized();
       fe.straight = d0.dot(d1) < -cosFeature;
+    }
+    // A corner of flat facets (every boundary face around n coplanar with another one, as on
+    // a box): sliding it would bend a facet and change the volume, so it does not slide.
+    // A face's twin may also be a boundary face of its other two nodes.
+    fe.polyhedral = !fe.to.empty();
+    for (size_t i = 0; i < bf.size() && fe.polyhedral; ++i) {
+      bool twin = false;
+      for (size_t j = 0; j < bf.size() && !twin; ++j) twin = j != i && bf[i].normal.dot(bf[j].normal) > 1.0 - 1e-9;
+      for (const int m : {bf[i].u, bf[i].v}) {
+        if (twin) break;
+        for (const auto& g : boundaryFacesOf(m))
+          if (g.u != n && g.v != n && bf[i].normal.dot(g.normal) > 1.0 - 1e-9) twin = true;
+      }
+      fe.polyhedral = twin;
     }
     return fe;
   };
@@ -404,7 +419,7 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
           bool slid = false;
           if (options.method == CutMethod::Hybrid) {
             const auto fe = featureEdgesOf(n);
-            const double reach = fe.straight ? region : std::min(region, options.feature_slide_fraction);
+            const double reach = fe.straight ? region : fe.polyhedral ? 0.0 : std::min(region, options.feature_slide_fraction);
             for (int r : fe.to) {
               const auto it = edgeIndex.find(edgeKey(n, r));
               if (it == edgeIndex.end()) continue;
@@ -549,7 +564,7 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
             if (on[r] || !(g > rate)) continue;
             rate = g;
             dir = e / len;
-            maxStep = (fe.straight ? 0.5 : options.feature_slide_fraction) * len;
+            maxStep = (fe.straight ? 0.5 : fe.polyhedral ? 0.0 : options.feature_slide_fraction) * len;
           }
           if (!(rate > 0.25)) continue;
         }
@@ -606,7 +621,7 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
       approx[n] = 1;
       on[n] = 1;
       onNodes.push_back(n);
-      ++report.through_nodes;
+      ++report.routed_nodes;
       for (int s = starOff[n]; s < starOff[n + 1]; ++s) {
         const Tet tv = w.tet(starTet[s]);
         for (int k = 0; k < 4; ++k) {
@@ -627,6 +642,11 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
         if (!ce.alive && approx[ce.a] && approx[ce.b] && ce.t >= options.through_node_fraction &&
             1.0 - ce.t >= options.through_node_fraction)
           ce.alive = true;
+    if (!approx.empty())
+      for (int n = 0; n < N0; ++n)
+        if (approx[n])
+          report.max_route_deviation_mm =
+              std::max(report.max_route_deviation_mm, std::abs(plane ? phi[n] : surface.signedDistance(w.x(n))));
   }
 
   // 3. Subdivision: split every edge still crossed (conforming bisection of the tets around

@@ -4,6 +4,7 @@
 // 20 successive cuts) is measured by `hysim tables --table 2` and reported, not asserted.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <random>
 
@@ -16,13 +17,21 @@ namespace {
 
 using Vec3 = Eigen::Vector3d;
 
-void randomPlanes(const TetMesh& mesh, int planes, const Cut3DOptions& options, double* worstQ, double* worstE) {
+void randomPlanes(const TetMesh& mesh, int planes, const Cut3DOptions& options, double* worstQ, double* worstE,
+                  int* routed, double* deviation) {
   const auto s0 = computeStats(mesh);
+  double edgeMax = 0;
+  for (int t = 0; t < mesh.numTets(); ++t)
+    for (int a = 0; a < 4; ++a)
+      for (int b = a + 1; b < 4; ++b)
+        edgeMax = std::max(edgeMax, (mesh.X.row(mesh.T(t, a)) - mesh.X.row(mesh.T(t, b))).norm());
   const double v0 = totalVolume(mesh);
   const Vec3 lo = mesh.X.colwise().minCoeff().transpose(), hi = mesh.X.colwise().maxCoeff().transpose();
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> u(0.3, 0.7), g(-1, 1);
   *worstQ = *worstE = 1e300;
+  *routed = 0;
+  *deviation = 0;
   for (int p = 0; p < planes; ++p) {
     const Vec3 c = lo + (hi - lo).cwiseProduct(Vec3(u(rng), u(rng), u(rng)));
     const Vec3 n(g(rng), g(rng), g(rng));
@@ -30,8 +39,16 @@ void randomPlanes(const TetMesh& mesh, int planes, const Cut3DOptions& options, 
     ASSERT_TRUE(r.ok()) << r.error();
     const auto v = validate(r->mesh);
     ASSERT_TRUE(v.ok()) << "plane " << p << ": " << v.error();
-    EXPECT_EQ(countStraddling(r->mesh, c, n, 1e-7), 0) << "plane " << p;
-    EXPECT_EQ(countFacesSharedAcross(r->mesh, c, n, 1e-7), 0) << "plane " << p;
+    // Exact sides, or within the routed nodes' distance (Cut3DOptions::through_node_fraction).
+    if (options.through_node_fraction == 0) {
+      EXPECT_EQ(r->report.routed_nodes, 0);
+    }
+    const double eps = std::max(1e-7, r->report.max_route_deviation_mm * (1 + 1e-9));
+    EXPECT_LE(r->report.max_route_deviation_mm, options.through_node_fraction * edgeMax) << "plane " << p;
+    EXPECT_EQ(countStraddling(r->mesh, c, n, eps), 0) << "plane " << p;
+    EXPECT_EQ(countFacesSharedAcross(r->mesh, c, n, eps), 0) << "plane " << p;
+    *routed += r->report.routed_nodes;
+    *deviation = std::max(*deviation, r->report.max_route_deviation_mm);
     EXPECT_LE(r->mesh.numTets(), 1.10 * mesh.numTets()) << "plane " << p;
     EXPECT_NEAR(totalVolume(r->mesh), v0, 1e-3 * v0) << "plane " << p;
     for (int t = 0; t < r->mesh.numTets(); ++t) ASSERT_GT(tetVolume(r->mesh, t), 0.0);
@@ -46,8 +63,9 @@ TEST(Cut3DAcceptance, UterusRandomPlanesValidGrowthVolume) {
   if (!std::filesystem::exists(path)) GTEST_SKIP() << "no " << path;
   auto mesh = readTetMesh(path);
   ASSERT_TRUE(mesh.ok()) << mesh.error();
-  double q = 0, e = 0;
-  randomPlanes(*mesh, 40, {}, &q, &e);
+  double q = 0, e = 0, dev = 0;
+  int routed = 0;
+  randomPlanes(*mesh, 40, {}, &q, &e, &routed, &dev);
   // Reported, not yet asserted (acceptance wants >= 0.25 and >= 0.2 for every plane).
   RecordProperty("worst_q_ratio", std::to_string(q));
   RecordProperty("worst_edge_ratio", std::to_string(e));
@@ -64,11 +82,36 @@ TEST(Cut3DAcceptance, UterusRandomPlanesFeatureSlide) {
   ASSERT_TRUE(mesh.ok()) << mesh.error();
   Cut3DOptions o;
   o.feature_slide_fraction = 0.15;
-  double q = 0, e = 0;
-  randomPlanes(*mesh, 40, o, &q, &e);
+  double q = 0, e = 0, dev = 0;
+  int routed = 0;
+  randomPlanes(*mesh, 40, o, &q, &e, &routed, &dev);
   std::printf("uterus, 40 random planes, feature slide 0.15: worst q*_min ratio %.3f, worst min edge ratio %.3f\n", q, e);
   EXPECT_GE(q, 0.03);
   EXPECT_GE(e, 0.04);
+}
+
+// Through-node routing as a last resort (crossings still within 0.1 |e| of a node after
+// snapping, the away move and ridge/feature sliding were refused) together with feature
+// sliding: elements around a routed node straddle the plane by at most its distance, checked
+// with that tolerance. Over 100 planes (seeds 7 / 11) this lifts the worst q*_min ratio from
+// 0.015 / 0.004 to 0.12 / 0.07 and the worst min edge ratio from 0.018 / 0.009 to 0.23 / 0.24
+// (routed nodes <= 0.41 / 0.36 mm off the plane); q*_min >= 0.25x still does not hold.
+TEST(Cut3DAcceptance, UterusRandomPlanesRoutingAndFeatureSlide) {
+  const std::string path = std::string(HYSIM_SOURCE_DIR) + "/assets/uterus_myoma.msh";
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << "no " << path;
+  auto mesh = readTetMesh(path);
+  ASSERT_TRUE(mesh.ok()) << mesh.error();
+  Cut3DOptions o;
+  o.through_node_fraction = 0.1;
+  o.feature_slide_fraction = 0.15;
+  double q = 0, e = 0, dev = 0;
+  int routed = 0;
+  randomPlanes(*mesh, 40, o, &q, &e, &routed, &dev);
+  std::printf("uterus, 40 random planes, routing 0.1 + feature slide 0.15: worst q*_min ratio %.3f, worst min edge "
+              "ratio %.3f, %d routed nodes, max deviation %.3f mm\n",
+              q, e, routed, dev);
+  EXPECT_GE(e, 0.2);  // the acceptance bound on the minimum edge holds
+  EXPECT_GE(q, 0.06); // regression floor; the acceptance bound 0.25 does not hold yet
 }
 
 TEST(Cut3DAcceptance, Table2EllipsoidHybridKeepsQuality) {
