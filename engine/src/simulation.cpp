@@ -5,9 +5,12 @@
 
 #include <algorithm>
 #include <assimp/Importer.hpp>
+#include <chrono>
 #include <cmath>
 
+#include "hysim/cutting/cut3d.hpp"
 #include "hysim/cutting/mesh_io.hpp"
+#include "hysim/cutting/mesh_stats.hpp"
 
 namespace hysim::engine {
 namespace {
@@ -51,6 +54,76 @@ Result<render::SurfaceMesh> loadSurface(const std::string& path, render::Surface
   return out;
 }
 
+Status Simulation::setTopology(cutting::TetMesh rest_mesh, const sim::NodeVectors* x, const sim::NodeVectors* v) {
+  mesh_ = std::move(rest_mesh);
+  std::vector<int> fixed;
+  for (int i = 0; i < mesh_.numNodes(); ++i) {
+    const Eigen::Vector3d p = mesh_.X.row(i).transpose();
+    for (const AnchorRegion& a : scene_.anchors) {
+      if (a.contains(p)) {
+        fixed.push_back(i);
+        break;
+      }
+    }
+  }
+  num_anchored_ = static_cast<int>(fixed.size());
+  auto model = sim::buildModel(mesh_, scene_.materials, fixed, scene_.sim);
+  if (!model.ok()) return Error{model.error()};
+  model_ = std::move(model.value());
+  const int warnings = state_.warnings;
+  const std::uint64_t steps = state_.steps;
+  const double time = state_.time;
+  state_ = sim::makeState(model_, mesh_);
+  if (x != nullptr) state_.x = *x;
+  if (v != nullptr) state_.v = *v;
+  state_.warnings = warnings;
+  state_.steps = steps;
+  state_.time = time;
+  num_deformable_tets_ = 0;
+  for (int t = 0; t < mesh_.numTets(); ++t) {
+    bool moves = false;
+    for (int c = 0; c < 4; ++c) moves = moves || !model_.fixed[mesh_.T(t, c)];
+    num_deformable_tets_ += moves ? 1 : 0;
+  }
+
+  // Surface for contact and rendering: boundary faces, compacted vertex numbering.
+  Eigen::VectorXi face_tet;
+  surface_faces_ = cutting::boundaryFaces(mesh_, &face_tet);
+  surface_nodes_.clear();
+  surface_triangles_.clear();
+  surface_material_.clear();
+  contact_nodes_.clear();
+  std::vector<int> local(mesh_.numNodes(), -1);
+  // A surface vertex is drawn as myoma when all its boundary faces belong to myoma tets:
+  // the rim where the myoma meets the wall keeps the endometrium colour, so the colour
+  // blend happens on the myoma's side (its base is covered by endometrium in reality).
+  int myoma_label = -1;
+  for (const sim::Material& m : scene_.materials) {
+    if (m.name == "myoma") myoma_label = m.label;
+  }
+  for (int f = 0; f < surface_faces_.rows(); ++f) {
+    for (int c = 0; c < 3; ++c) {
+      const int node = surface_faces_(f, c);
+      if (local[node] < 0) {
+        local[node] = static_cast<int>(surface_nodes_.size());
+        surface_nodes_.push_back(node);
+        surface_material_.push_back(render::SurfaceMaterial::Myoma);
+      }
+      surface_triangles_.push_back(static_cast<std::uint32_t>(local[node]));
+      if (mesh_.material[face_tet[f]] != myoma_label) {
+        surface_material_[local[node]] = render::SurfaceMaterial::Endometrium;
+      }
+    }
+  }
+  for (int node : surface_nodes_) {
+    if (!model_.fixed[node]) contact_nodes_.push_back(node);
+  }
+  contact_force_ = sim::NodeVectors::Zero(mesh_.numNodes(), 3);
+  locator_.build(mesh_, state_.x);
+  ++topology_version_;
+  return Status::Ok();
+}
+
 Result<std::unique_ptr<Simulation>> Simulation::create(const Scene& scene) {
   std::unique_ptr<Simulation> s(new Simulation());
   s->scene_ = scene;
@@ -61,58 +134,14 @@ Result<std::unique_ptr<Simulation>> Simulation::create(const Scene& scene) {
     return Error{scene.mesh_path + ": invalid mesh: " + valid.error()};
   }
 
-  std::vector<int> fixed;
-  for (int i = 0; i < s->mesh_.numNodes(); ++i) {
-    const Eigen::Vector3d p = s->mesh_.X.row(i).transpose();
-    for (const AnchorRegion& a : scene.anchors) {
-      if (a.contains(p)) {
-        fixed.push_back(i);
-        break;
-      }
-    }
-  }
-  s->num_anchored_ = static_cast<int>(fixed.size());
-  auto model = sim::buildModel(s->mesh_, scene.materials, fixed, scene.sim);
-  if (!model.ok()) return Error{scene.path + ": " + model.error()};
-  s->model_ = std::move(model.value());
-  s->state_ = sim::makeState(s->model_, s->mesh_);
-  for (int t = 0; t < s->mesh_.numTets(); ++t) {
-    bool moves = false;
-    for (int c = 0; c < 4; ++c) moves = moves || !s->model_.fixed[s->mesh_.T(t, c)];
-    s->num_deformable_tets_ += moves ? 1 : 0;
-  }
   s->device_ = std::make_unique<haptics::ScriptedDevice>(haptics::Trajectory(scene.tool_path));
   s->pose_ = s->device_->read(0.0).pose;
-
-  // Surface for contact and rendering: boundary faces, compacted vertex numbering.
-  Eigen::VectorXi face_tet;
-  s->surface_faces_ = cutting::boundaryFaces(s->mesh_, &face_tet);
-  std::vector<int> local(s->mesh_.numNodes(), -1);
-  // A surface vertex is drawn as myoma when all its boundary faces belong to myoma tets:
-  // the rim where the myoma meets the wall keeps the endometrium colour, so the colour
-  // blend happens on the myoma's side (its base is covered by endometrium in reality).
-  int myoma_label = -1;
-  for (const sim::Material& m : scene.materials) {
-    if (m.name == "myoma") myoma_label = m.label;
-  }
-  for (int f = 0; f < s->surface_faces_.rows(); ++f) {
-    for (int c = 0; c < 3; ++c) {
-      const int node = s->surface_faces_(f, c);
-      if (local[node] < 0) {
-        local[node] = static_cast<int>(s->surface_nodes_.size());
-        s->surface_nodes_.push_back(node);
-        s->surface_material_.push_back(render::SurfaceMaterial::Myoma);
-      }
-      s->surface_triangles_.push_back(static_cast<std::uint32_t>(local[node]));
-      if (s->mesh_.material[face_tet[f]] != myoma_label) {
-        s->surface_material_[local[node]] = render::SurfaceMaterial::Endometrium;
-      }
-    }
-  }
-  for (int node : s->surface_nodes_) {
-    if (!s->model_.fixed[node]) s->contact_nodes_.push_back(node);
-  }
-  s->contact_force_ = sim::NodeVectors::Zero(s->mesh_.numNodes(), 3);
+  s->loop_.loop_radius_mm = scene.contact.loop_radius_mm;
+  s->loop_.reach_mm = scene.contact.loop_reach_mm;
+  s->loop_.drop_mm = scene.contact.loop_drop_mm;
+  loopPoints(s->loop_, s->pose_, s->wire_);  // sizes the wire buffers once
+  s->previous_wire_ = s->wire_;
+  if (Status st = s->setTopology(s->mesh_, nullptr, nullptr); !st.ok()) return Error{scene.path + ": " + st.error()};
 
   if (!scene.tool_mesh_path.empty()) {
     auto tool = loadSurface(scene.tool_mesh_path, render::SurfaceMaterial::Tool);
@@ -149,8 +178,16 @@ void Simulation::computeContact() {
   for (int node : contact_nodes_) {
     const Eigen::Vector3d p = state_.x.row(node).transpose();
     push(node, closestOnSegment(p, shaft_a, shaft_b), c.shaft_radius_mm);
-    push(node, loop, c.loop_radius_mm);
+    if (!pose_.pedal) push(node, loop, c.loop_radius_mm);  // an active electrode cuts instead
   }
+}
+
+bool Simulation::wireInTissue() {
+  if (locator_.maxDisplacement(state_.x) > locator_.margin()) locator_.build(mesh_, state_.x);
+  for (Eigen::Index i = 0; i < wire_.rows(); ++i) {
+    if (locator_.locate(mesh_, state_.x, wire_.row(i).transpose()) >= 0) return true;
+  }
+  return false;
 }
 
 void Simulation::step() {
@@ -161,6 +198,141 @@ void Simulation::step() {
   input.external_force = &contact_force_;
   sim::step(model_, state_, input);
   device_->commandForce(tool_force_n_);  // clamped and NaN-guarded by the device
+
+  // Shaving: entry is the first step the active loop is in the tissue; the sweep grows while
+  // it stays there; on exit (or pedal release) the sweep is cut.
+  previous_wire_ = wire_;
+  loopPoints(loop_, pose_, wire_);
+  if (!pose_.pedal && !cutting_) {
+    loop_in_tissue_ = false;
+    return;
+  }
+  loop_in_tissue_ = pose_.pedal && wireInTissue();
+  if (loop_in_tissue_ && !cutting_) {
+    cutting_ = true;
+    sweep_.clear();
+    if (previous_wire_.rows() == wire_.rows()) sweep_.advance(previous_wire_);
+    sweep_.advance(wire_);
+  } else if (loop_in_tissue_) {
+    sweep_.advance(wire_);
+  } else if (cutting_) {
+    sweep_.advance(wire_);
+    finishPass();
+  }
+}
+
+void Simulation::finishPass() {
+  using Clock = std::chrono::steady_clock;
+  const auto t0 = Clock::now();
+  cutting_ = false;
+  PassRecord rec;
+  rec.time_s = state_.time;
+  Eigen::Matrix<double, Eigen::Dynamic, 3> sv;
+  Eigen::Matrix<int, Eigen::Dynamic, 3> sf;
+  sweep_.extendedSurface(1.5, sv, sf);
+  sweep_.clear();
+  auto fail = [&](const std::string& why) {
+    rec.cut_failed = true;
+    rec.message = why;
+    rec.elements = mesh_.numTets();
+    rec.nodes = mesh_.numNodes();
+    passes_.push_back(rec);
+  };
+  if (sf.rows() == 0) return fail("sweep too short");
+  auto surface = cutting::CutSurface::triangles(sv, sf);
+  if (!surface.ok()) return fail(surface.error());
+  cutting::TetMesh current = mesh_;  // the cut happens in the deformed configuration
+  current.X = state_.x;
+  cutting::Cut3DOptions options;
+  options.method = cutting::CutMethod::Hybrid;
+  auto cut = cutting::cut3d(current, *surface, options);
+  if (!cut.ok()) return fail(cut.error());
+  const cutting::TopologyChange& change = cut->change;
+  const cutting::TetMesh& after = cut->mesh;
+
+  // Rest positions and velocities of the new mesh: surviving nodes keep theirs (plus what
+  // the cut moved them by); new nodes interpolate their parents.
+  const int n = after.numNodes();
+  cutting::Positions rest(n, 3);
+  sim::NodeVectors v(n, 3);
+  std::vector<char> known(n, 0);
+  for (int i = 0; i < static_cast<int>(change.node_old_to_new.size()); ++i) {
+    const int j = change.node_old_to_new[i];
+    if (j < 0 || known[j]) continue;
+    rest.row(j) = mesh_.X.row(i) + (after.X.row(j) - current.X.row(i));
+    v.row(j) = state_.v.row(i);
+    known[j] = 1;
+  }
+  for (const cutting::NewNode& nn : change.new_nodes) {
+    if (nn.id < 0 || nn.id >= n || known[nn.id]) continue;
+    Eigen::RowVector3d r = Eigen::RowVector3d::Zero(), x = r, vel = r;
+    for (int k = 0; k < nn.num_parents; ++k) {
+      r += nn.weights[k] * mesh_.X.row(nn.parents[k]);
+      x += nn.weights[k] * current.X.row(nn.parents[k]);
+      vel += nn.weights[k] * state_.v.row(nn.parents[k]);
+    }
+    rest.row(nn.id) = r + (after.X.row(nn.id) - x);
+    v.row(nn.id) = vel;
+    known[nn.id] = 1;
+  }
+
+  // Chips: pieces connected to no anchored node are removed (their volume is resected).
+  std::vector<int> anchored;
+  for (int i = 0; i < n; ++i) {
+    for (const AnchorRegion& a : scene_.anchors) {
+      if (a.contains(rest.row(i).transpose())) {
+        anchored.push_back(i);
+        break;
+      }
+    }
+  }
+  const cutting::Components3D comps = cutting::tetComponents(after, anchored);
+  int myoma_label = -1;
+  for (const sim::Material& m : scene_.materials) {
+    if (m.name == "myoma") myoma_label = m.label;
+  }
+  std::vector<int> keep_tets;
+  keep_tets.reserve(after.numTets());
+  for (int t = 0; t < after.numTets(); ++t) {
+    if (!comps.free[comps.label[t]]) {
+      keep_tets.push_back(t);
+      continue;
+    }
+    const double vol = std::abs(cutting::tetVolume(after, t));
+    rec.removed_mm3 += vol;
+    if (after.material[t] == myoma_label) rec.removed_myoma_mm3 += vol;
+  }
+  for (int c = 0; c < comps.count; ++c) rec.chips += comps.free[c] ? 1 : 0;
+  std::vector<int> new_index(n, -1);
+  int kept_nodes = 0;
+  for (int t : keep_tets)
+    for (int k = 0; k < 4; ++k)
+      if (new_index[after.T(t, k)] < 0) new_index[after.T(t, k)] = kept_nodes++;
+  cutting::TetMesh rest_mesh;
+  rest_mesh.X.resize(kept_nodes, 3);
+  sim::NodeVectors x_kept(kept_nodes, 3), v_kept(kept_nodes, 3);
+  for (int i = 0; i < n; ++i) {
+    if (new_index[i] < 0) continue;
+    rest_mesh.X.row(new_index[i]) = rest.row(i);
+    x_kept.row(new_index[i]) = after.X.row(i);
+    v_kept.row(new_index[i]) = v.row(i);
+  }
+  rest_mesh.T.resize(static_cast<Eigen::Index>(keep_tets.size()), 4);
+  rest_mesh.material.resize(static_cast<Eigen::Index>(keep_tets.size()));
+  for (size_t k = 0; k < keep_tets.size(); ++k) {
+    for (int c = 0; c < 4; ++c) rest_mesh.T(static_cast<Eigen::Index>(k), c) = new_index[after.T(keep_tets[k], c)];
+    rest_mesh.material[static_cast<Eigen::Index>(k)] = after.material[keep_tets[k]];
+  }
+  // If mapping the cut back to rest positions inverted anything (large deformation at the
+  // cut), the current shape becomes the rest shape: the tissue relaxes there.
+  if (!cutting::validate(rest_mesh).ok()) rest_mesh.X = x_kept;
+  if (Status st = setTopology(std::move(rest_mesh), &x_kept, &v_kept); !st.ok()) return fail(st.error());
+  const cutting::MeshStats stats = cutting::computeStats(mesh_);
+  rec.elements = mesh_.numTets();
+  rec.nodes = mesh_.numNodes();
+  rec.q_min = stats.q_min;
+  rec.cut_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+  passes_.push_back(rec);
 }
 
 void Simulation::fillSnapshot(render::RenderSnapshot& snap) const {
@@ -169,8 +341,11 @@ void Simulation::fillSnapshot(render::RenderSnapshot& snap) const {
   for (size_t i = 0; i < nv; ++i) {
     for (int c = 0; c < 3; ++c) snap.tissue.positions[3 * i + c] = static_cast<float>(state_.x(surface_nodes_[i], c));
   }
-  if (snap.tissue.triangles.size() != surface_triangles_.size()) snap.tissue.triangles = surface_triangles_;
-  if (snap.tissue.material.size() != surface_material_.size()) snap.tissue.material = surface_material_;
+  if (snap.topology_version != topology_version_) {
+    snap.tissue.triangles = surface_triangles_;
+    snap.tissue.material = surface_material_;
+    snap.topology_version = topology_version_;
+  }
   if (snap.tool.positions.size() != tool_surface_.positions.size()) snap.tool = tool_surface_;
   snap.tool_visible = !tool_surface_.triangles.empty();
   // The sheath stays at the scope tip; the electrode (everything ahead of the tip in the

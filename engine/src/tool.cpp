@@ -65,6 +65,40 @@ Eigen::Matrix<int, Eigen::Dynamic, 3> Sweep::triangles() const {
   return f;
 }
 
+void Sweep::extendedSurface(double extra_mm, Eigen::Matrix<double, Eigen::Dynamic, 3>& vertices,
+                            Eigen::Matrix<int, Eigen::Dynamic, 3>& triangles) const {
+  if (num_rows_ < 2) {
+    vertices.resize(0, 3);
+    triangles.resize(0, 3);
+    return;
+  }
+  const int n = row_size_;
+  auto row = [&](int r, int i) -> const Eigen::Vector3d& { return points_[static_cast<size_t>(r) * n + i]; };
+  auto motion = [&](int from, int to) {
+    Eigen::Vector3d d = Eigen::Vector3d::Zero();
+    for (int i = 0; i < n; ++i) d += row(to, i) - row(from, i);
+    return d.norm() > 0.0 ? Eigen::Vector3d(d.normalized()) : d;
+  };
+  const Eigen::Vector3d start_dir = motion(0, 1), end_dir = motion(num_rows_ - 2, num_rows_ - 1);
+  const int rows = num_rows_ + 2;
+  vertices.resize(static_cast<Eigen::Index>(rows) * n, 3);
+  for (int i = 0; i < n; ++i) vertices.row(i) = (row(0, i) - extra_mm * start_dir).transpose();
+  for (int r = 0; r < num_rows_; ++r)
+    for (int i = 0; i < n; ++i) vertices.row(static_cast<Eigen::Index>(r + 1) * n + i) = row(r, i).transpose();
+  for (int i = 0; i < n; ++i) {
+    vertices.row(static_cast<Eigen::Index>(rows - 1) * n + i) = (row(num_rows_ - 1, i) + extra_mm * end_dir).transpose();
+  }
+  triangles.resize(2 * (rows - 1) * (n - 1), 3);
+  int t = 0;
+  for (int r = 0; r + 1 < rows; ++r) {
+    for (int i = 0; i + 1 < n; ++i) {
+      const int a = r * n + i, b = a + 1, c = a + n, d = c + 1;
+      triangles.row(t++) << a, b, d;
+      triangles.row(t++) << a, d, c;
+    }
+  }
+}
+
 double Sweep::area() const {
   const auto v = vertices();
   const auto f = triangles();

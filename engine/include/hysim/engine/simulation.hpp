@@ -8,17 +8,36 @@
 
 #include "hysim/cutting/mesh.hpp"
 #include "hysim/engine/scene.hpp"
+#include "hysim/engine/tet_locator.hpp"
+#include "hysim/engine/tool.hpp"
 #include "hysim/haptics/device.hpp"
 #include "hysim/render/snapshot.hpp"
 #include "hysim/sim/model.hpp"
 
 namespace hysim::engine {
 
+// One shaving pass: the loop entered the tissue with the pedal down and left it (or the
+// pedal was released); the accumulated sweep was cut with the hybrid method.
+struct PassRecord {
+  double time_s = 0.0;
+  int elements = 0;          // after the pass (chips removed)
+  int nodes = 0;
+  double q_min = 0.0;        // q* = r_in / R_circ of the worst tet after the pass
+  double cut_ms = 0.0;       // cut + chip removal + model rebuild
+  int chips = 0;             // free pieces removed
+  double removed_mm3 = 0.0;  // volume of the removed chips
+  double removed_myoma_mm3 = 0.0;
+  bool cut_failed = false;   // the cut was refused (the mesh is left as it was)
+  std::string message;
+};
+
 class Simulation {
  public:
   // Loads the meshes named by the scene, anchors nodes, builds the tissue model.
   static Result<std::unique_ptr<Simulation>> create(const Scene& scene);
 
+  // Advances one fixed step. Allocates nothing, except on the step a shaving pass ends
+  // (the loop leaves the tissue), when the cut changes the topology.
   void step();
 
   // Fills a snapshot for the renderer. Reuses the snapshot's buffers (no allocation after
@@ -39,6 +58,10 @@ class Simulation {
   // Reaction force on the tool from tissue contact in the last step, newtons.
   const Eigen::Vector3d& toolForceN() const { return tool_force_n_; }
   std::uint64_t stateHash() const { return sim::stateHash(state_); }
+  const std::vector<PassRecord>& passes() const { return passes_; }
+  bool loopInTissue() const { return loop_in_tissue_; }
+  const LoopGeometry& loop() const { return loop_; }
+  int topologyVersion() const { return topology_version_; }
   // Puts back a state saved from this simulation (benchmarks restore one before each batch).
   // Same topology only; copies into the existing buffers.
   void restoreState(const sim::State& saved) { state_ = saved; }
@@ -46,6 +69,11 @@ class Simulation {
  private:
   Simulation() = default;
   void computeContact();
+  // Replaces the mesh (rest positions) and everything built from it; x, v (#N x 3) are the
+  // current positions and velocities (null: rest and zero).
+  Status setTopology(cutting::TetMesh rest_mesh, const sim::NodeVectors* x, const sim::NodeVectors* v);
+  bool wireInTissue();
+  void finishPass();
 
   Scene scene_;
   cutting::TetMesh mesh_;
@@ -64,6 +92,16 @@ class Simulation {
   render::SurfaceMesh tool_surface_;              // body frame
   int num_anchored_ = 0;
   int num_deformable_tets_ = 0;
+
+  // Shaving.
+  LoopGeometry loop_;
+  TetLocator locator_;
+  Eigen::Matrix<double, Eigen::Dynamic, 3> wire_, previous_wire_;
+  Sweep sweep_;
+  bool loop_in_tissue_ = false;
+  bool cutting_ = false;
+  int topology_version_ = 0;
+  std::vector<PassRecord> passes_;
 };
 
 // Loads a surface (OBJ, STL, PLY, glTF...) with assimp, triangulated, in millimetres.

@@ -36,6 +36,11 @@ class Sweep {
   Eigen::Matrix<double, Eigen::Dynamic, 3> vertices() const;
   Eigen::Matrix<int, Eigen::Dynamic, 3> triangles() const;
   double area() const;                // mm^2
+  // The sweep with one more wire row before its start and after its end, `extra_mm` along
+  // the direction of motion there: a cut with it surely reaches through the surface where
+  // the loop entered and where it left. Empty when fewer than two rows were recorded.
+  void extendedSurface(double extra_mm, Eigen::Matrix<double, Eigen::Dynamic, 3>& vertices,
+                       Eigen::Matrix<int, Eigen::Dynamic, 3>& triangles) const;
   double pathLength() const { return path_length_; }  // of the wire's middle point, mm
 
  private:

@@ -52,6 +52,7 @@ struct RenderSnapshot {
   bool tool_visible = false;
   Camera camera;
   std::uint64_t step = 0;          // simulation step this snapshot was taken at
+  int topology_version = -1;       // changes when the tissue's triangles change (a cut)
   double time_s = 0.0;
 };
 

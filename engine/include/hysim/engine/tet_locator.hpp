@@ -1,0 +1,36 @@
+#pragma once
+// Which tet contains a point, for the loop electrode's "is the wire in the tissue" test.
+// A uniform grid over the tets' bounding boxes, built with a margin; queries use the
+// current node positions, so the grid stays valid while no node has moved further than the
+// margin since the build (the caller rebuilds when one has, and after topology changes).
+//
+// (FCL was measured for this first, see collision.hpp: its AABB models are copied and
+// rebuilt on every query, 0.7 ms, too slow for every 1 ms step.)
+#include <Eigen/Core>
+#include <vector>
+
+#include "hysim/cutting/mesh.hpp"
+#include "hysim/sim/model.hpp"
+
+namespace hysim::engine {
+
+class TetLocator {
+ public:
+  void build(const cutting::TetMesh& mesh, const sim::NodeVectors& x, double margin_mm = 1.0);
+  // Tet containing p at positions x, or -1. Allocates nothing.
+  int locate(const cutting::TetMesh& mesh, const sim::NodeVectors& x, const Eigen::Vector3d& p) const;
+  // Largest node displacement since the build (O(#N)); rebuild when it exceeds margin().
+  double maxDisplacement(const sim::NodeVectors& x) const;
+  double margin() const { return margin_; }
+
+ private:
+  Eigen::Vector3d origin_{0, 0, 0};
+  double cell_ = 1.0;
+  Eigen::Vector3i dims_{0, 0, 0};
+  std::vector<int> cell_start_;  // #cells + 1
+  std::vector<int> cell_tets_;
+  sim::NodeVectors built_x_;
+  double margin_ = 1.0;
+};
+
+}  // namespace hysim::engine

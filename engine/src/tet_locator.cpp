@@ -1,0 +1,89 @@
+#include "hysim/engine/tet_locator.hpp"
+
+#include <Eigen/LU>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace hysim::engine {
+
+void TetLocator::build(const cutting::TetMesh& mesh, const sim::NodeVectors& x, double margin_mm) {
+  margin_ = margin_mm;
+  built_x_ = x;
+  const int nt = mesh.numTets();
+  cell_start_.clear();
+  cell_tets_.clear();
+  dims_.setZero();
+  if (nt == 0 || x.rows() == 0) return;
+  Eigen::Vector3d lo = x.colwise().minCoeff().transpose(), hi = x.colwise().maxCoeff().transpose();
+  lo.array() -= margin_;
+  hi.array() += margin_;
+  // Cells about twice the mean tet size: a few tets per cell.
+  const double volume = (hi - lo).prod();
+  cell_ = std::max(1e-6, 2.0 * std::cbrt(volume / nt));
+  origin_ = lo;
+  for (int c = 0; c < 3; ++c) dims_[c] = std::max(1, static_cast<int>(std::ceil((hi[c] - lo[c]) / cell_)));
+  const long cells = static_cast<long>(dims_.x()) * dims_.y() * dims_.z();
+  std::vector<int> count(cells + 1, 0);
+  auto cellRange = [&](int t, Eigen::Vector3i& a, Eigen::Vector3i& b) {
+    Eigen::Vector3d tlo = x.row(mesh.T(t, 0)).transpose(), thi = tlo;
+    for (int k = 1; k < 4; ++k) {
+      tlo = tlo.cwiseMin(x.row(mesh.T(t, k)).transpose());
+      thi = thi.cwiseMax(x.row(mesh.T(t, k)).transpose());
+    }
+    for (int c = 0; c < 3; ++c) {
+      a[c] = std::clamp(static_cast<int>(std::floor((tlo[c] - margin_ - origin_[c]) / cell_)), 0, dims_[c] - 1);
+      b[c] = std::clamp(static_cast<int>(std::floor((thi[c] + margin_ - origin_[c]) / cell_)), 0, dims_[c] - 1);
+    }
+  };
+  auto index = [&](int i, int j, int k) { return (static_cast<long>(k) * dims_.y() + j) * dims_.x() + i; };
+  Eigen::Vector3i a, b;
+  for (int t = 0; t < nt; ++t) {
+    cellRange(t, a, b);
+    for (int k = a.z(); k <= b.z(); ++k)
+      for (int j = a.y(); j <= b.y(); ++j)
+        for (int i = a.x(); i <= b.x(); ++i) ++count[index(i, j, k) + 1];
+  }
+  for (long c = 0; c < cells; ++c) count[c + 1] += count[c];
+  cell_start_.assign(count.begin(), count.end());
+  cell_tets_.resize(cell_start_.back());
+  std::vector<int> fill(cell_start_.begin(), cell_start_.end() - 1);
+  for (int t = 0; t < nt; ++t) {
+    cellRange(t, a, b);
+    for (int k = a.z(); k <= b.z(); ++k)
+      for (int j = a.y(); j <= b.y(); ++j)
+        for (int i = a.x(); i <= b.x(); ++i) cell_tets_[fill[index(i, j, k)]++] = t;
+  }
+}
+
+int TetLocator::locate(const cutting::TetMesh& mesh, const sim::NodeVectors& x, const Eigen::Vector3d& p) const {
+  if (cell_start_.empty()) return -1;
+  int ijk[3];
+  for (int c = 0; c < 3; ++c) {
+    const int v = static_cast<int>(std::floor((p[c] - origin_[c]) / cell_));
+    if (v < 0 || v >= dims_[c]) return -1;
+    ijk[c] = v;
+  }
+  const long cell = (static_cast<long>(ijk[2]) * dims_.y() + ijk[1]) * dims_.x() + ijk[0];
+  for (int e = cell_start_[cell]; e < cell_start_[cell + 1]; ++e) {
+    const int t = cell_tets_[e];
+    const Eigen::Vector3d a = x.row(mesh.T(t, 0)).transpose();
+    Eigen::Matrix3d m;
+    for (int k = 0; k < 3; ++k) m.col(k) = x.row(mesh.T(t, k + 1)).transpose() - a;
+    const double det = m.determinant();
+    if (std::abs(det) < 1e-300) continue;
+    const Eigen::Vector3d w = m.inverse() * (p - a);  // barycentric coordinates of nodes 1..3
+    if (w.minCoeff() >= 0.0 && w.sum() <= 1.0) return t;
+  }
+  return -1;
+}
+
+double TetLocator::maxDisplacement(const sim::NodeVectors& x) const {
+  if (x.rows() != built_x_.rows()) return std::numeric_limits<double>::infinity();
+  double worst = 0.0;
+  for (Eigen::Index i = 0; i < x.rows(); ++i) worst = std::max(worst, (x.row(i) - built_x_.row(i)).squaredNorm());
+  return std::sqrt(worst);
+}
+
+}  // namespace hysim::engine
