@@ -72,6 +72,7 @@ Result<RunReport> run(Simulation& sim, const RunOptions& options) {
   r.frame_ms_median = percentile(frame_ms, 0.5);
   r.state_hash = sim.stateHash();
   r.warnings = sim.state().warnings;
+  r.passes = sim.passes();
   return r;
 }
 
@@ -95,6 +96,32 @@ std::string reportJson(const RunReport& r) {
   j["warnings"] = r.warnings;
   j["max_tool_force_n"] = r.max_tool_force_n;
   j["wall_s"] = r.wall_s;
+  std::vector<double> cut_ms;
+  nlohmann::ordered_json per_pass = nlohmann::ordered_json::array();
+  for (const PassRecord& p : r.passes) {
+    cut_ms.push_back(p.cut_ms);
+    nlohmann::ordered_json e;
+    e["time_s"] = p.time_s;
+    e["elements"] = p.elements;
+    e["nodes"] = p.nodes;
+    e["q_min"] = p.q_min;
+    e["cut_ms"] = p.cut_ms;
+    e["chips"] = p.chips;
+    e["removed_mm3"] = p.removed_mm3;
+    e["removed_myoma_mm3"] = p.removed_myoma_mm3;
+    e["sweep_area_mm2"] = p.sweep_area_mm2;
+    e["crossed_edges"] = p.crossed_edges;
+    e["snapped_nodes"] = p.snapped_nodes;
+    e["split_edges"] = p.split_edges;
+    e["duplicated_nodes"] = p.duplicated_nodes;
+    e["cut_faces"] = p.cut_faces;
+    e["components"] = p.components;
+    if (p.cut_failed) e["failed"] = p.message;
+    per_pass.push_back(e);
+  }
+  j["passes"] = r.passes.size();
+  j["cut_ms"] = {{"median", percentile(cut_ms, 0.5)}, {"max", cut_ms.empty() ? 0.0 : *std::max_element(cut_ms.begin(), cut_ms.end())}};
+  j["per_pass"] = per_pass;
   return j.dump(2) + "\n";
 }
 

@@ -239,6 +239,10 @@ void Simulation::finishPass() {
     passes_.push_back(rec);
   };
   if (sf.rows() == 0) return fail("sweep too short");
+  for (int t = 0; t < sf.rows(); ++t) {
+    rec.sweep_area_mm2 +=
+        0.5 * (sv.row(sf(t, 1)) - sv.row(sf(t, 0))).cross(sv.row(sf(t, 2)) - sv.row(sf(t, 0))).norm();
+  }
   auto surface = cutting::CutSurface::triangles(sv, sf);
   if (!surface.ok()) return fail(surface.error());
   cutting::TetMesh current = mesh_;  // the cut happens in the deformed configuration
@@ -248,6 +252,11 @@ void Simulation::finishPass() {
   auto cut = cutting::cut3d(current, *surface, options);
   if (!cut.ok()) return fail(cut.error());
   const cutting::TopologyChange& change = cut->change;
+  rec.crossed_edges = cut->report.crossed_edges;
+  rec.snapped_nodes = cut->report.snapped_nodes;
+  rec.split_edges = cut->report.split_edges;
+  rec.duplicated_nodes = cut->report.duplicated_nodes;
+  rec.cut_faces = cut->report.cut_faces;
   const cutting::TetMesh& after = cut->mesh;
 
   // Rest positions and velocities of the new mesh: surviving nodes keep theirs (plus what
@@ -303,6 +312,7 @@ void Simulation::finishPass() {
     if (after.material[t] == myoma_label) rec.removed_myoma_mm3 += vol;
   }
   for (int c = 0; c < comps.count; ++c) rec.chips += comps.free[c] ? 1 : 0;
+  rec.components = comps.count;
   std::vector<int> new_index(n, -1);
   int kept_nodes = 0;
   for (int t : keep_tets)

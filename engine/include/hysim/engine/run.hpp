@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <functional>
 #include <string>
+#include <vector>
 
 #include "hysim/engine/simulation.hpp"
 
@@ -31,6 +32,7 @@ struct RunReport {
   int warnings = 0;
   double max_tool_force_n = 0.0;
   double wall_s = 0.0;
+  std::vector<PassRecord> passes;  // shaving passes (cuts), in order
 };
 
 Result<RunReport> run(Simulation& simulation, const RunOptions& options);

@@ -27,6 +27,9 @@ struct PassRecord {
   int chips = 0;             // free pieces removed
   double removed_mm3 = 0.0;  // volume of the removed chips
   double removed_myoma_mm3 = 0.0;
+  double sweep_area_mm2 = 0.0;  // area of the cut surface (the loop's sweep)
+  int crossed_edges = 0, snapped_nodes = 0, split_edges = 0, duplicated_nodes = 0, cut_faces = 0;
+  int components = 0;
   bool cut_failed = false;   // the cut was refused (the mesh is left as it was)
   std::string message;
 };
