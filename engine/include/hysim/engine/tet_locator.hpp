@@ -16,7 +16,7 @@ namespace hysim::engine {
 
 class TetLocator {
  public:
-  void build(const cutting::TetMesh& mesh, const sim::NodeVectors& x, double margin_mm = 1.0);
+  void build(const cutting::TetMesh& mesh, const sim::NodeVectors& x, double margin_mm = 3.0);
   // Tet containing p at positions x, or -1. Allocates nothing.
   int locate(const cutting::TetMesh& mesh, const sim::NodeVectors& x, const Eigen::Vector3d& p) const;
   // Largest node displacement since the build (O(#N)); rebuild when it exceeds margin().

@@ -1,0 +1,91 @@
+// One shaving pass on a slab of tissue: the active loop is drawn through the top layer; on
+// exit the swept half-cylinder is cut and the chip comes off.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include "box_mesh.hpp"
+#include "hysim/cutting/cut3d.hpp"
+#include "hysim/cutting/mesh_io.hpp"
+#include "hysim/engine/run.hpp"
+#include "hysim/engine/scene.hpp"
+#include "hysim/engine/simulation.hpp"
+
+namespace hysim::engine {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Slab 30 x 20 x 10 mm, top face at z = 0, anchored at the bottom. The scope points along
+// +x with up = +z, so the loop (radius 3.5, centre 3 mm below the axis) hangs down; its
+// lowest point is 2 mm below the slab's top.
+std::string writeSlabScene(bool pedal) {
+  const fs::path dir = fs::path(HYSIM_TEST_OUTPUT_DIR) / "shaving";
+  fs::create_directories(dir);
+  cutting::TetMesh slab = testing::boxTetMesh(15, 10, 5, 2.0);
+  for (int i = 0; i < slab.numNodes(); ++i) slab.X.row(i) -= Eigen::RowVector3d(15, 10, 10);
+  EXPECT_TRUE(cutting::writeMesh((dir / "slab.msh").string(), slab).ok());
+  const std::string p = pedal ? "true" : "false";
+  std::ofstream(dir / (pedal ? "slab_cut.yaml" : "slab_nocut.yaml"))
+      << "name: slab\n"
+         "mesh: slab.msh\n"
+         "materials:\n"
+         "  - {name: myoma, label: 1, young_modulus_kpa: 150, density_g_cm3: 1.1}\n"
+         "anchors:\n"
+         "  - box: {min: [-20, -20, -11], max: [20, 20, -9.5]}\n"
+         "simulation: {dt_ms: 1.0, steps: 1300, drag_per_s: 30, gravity_mm_s2: [0, 0, 0]}\n"
+         "tool_path:\n"
+         "  - {t_s: 0.0, tip: [8, 0, 4.5], axis: [1, 0, 0], up: [0, 0, 1]}\n"
+         "  - {t_s: 0.05, tip: [8, 0, 4.5], axis: [1, 0, 0], up: [0, 0, 1], pedal: " << p << "}\n"
+         "  - {t_s: 1.05, tip: [-32, 0, 4.5], axis: [1, 0, 0], up: [0, 0, 1], pedal: " << p << "}\n"
+         "  - {t_s: 1.10, tip: [-32, 0, 4.5], axis: [1, 0, 0], up: [0, 0, 1]}\n";
+  return (dir / (pedal ? "slab_cut.yaml" : "slab_nocut.yaml")).string();
+}
+
+TEST(Shaving, OnePassThroughASlabCutsOnExit) {
+  auto scene = loadScene(writeSlabScene(true));
+  ASSERT_TRUE(scene.ok()) << scene.error();
+  auto sim = Simulation::create(*scene);
+  ASSERT_TRUE(sim.ok()) << sim.error();
+  bool entered = false;
+  int entry_step = -1;
+  for (int i = 0; i < 1300; ++i) {
+    (*sim)->step();
+    if ((*sim)->loopInTissue() && !entered) {
+      entered = true;
+      entry_step = i;
+    }
+  }
+  EXPECT_TRUE(entered);
+  // The loop's front (x = 20 at t = 0.05 s, moving at -40 mm/s) reaches the slab's end at x = 15.
+  EXPECT_NEAR(entry_step, 50 + 125, 15);
+  ASSERT_EQ((*sim)->passes().size(), 1u);
+  const PassRecord& pass = (*sim)->passes()[0];
+  EXPECT_FALSE(pass.cut_failed) << pass.message;
+  EXPECT_GT(pass.crossed_edges, 0);
+  EXPECT_GT(pass.sweep_area_mm2, 30.0 * 3.14159 * 3.5 * 0.5);  // half-cylinder across the slab
+  // The chip: the circular segment of the loop (R 3.5, centre 1.5 above the top, so 2 mm
+  // deep) across the slab's 30 mm: 30 * (R^2 acos(1.5/R) - 1.5 sqrt(R^2 - 1.5^2)).
+  const double segment = 3.5 * 3.5 * std::acos(1.5 / 3.5) - 1.5 * std::sqrt(3.5 * 3.5 - 1.5 * 1.5);
+  EXPECT_EQ(pass.chips, 1);
+  EXPECT_NEAR(pass.removed_mm3, 30.0 * segment, 0.25 * 30.0 * segment);
+  EXPECT_LT((*sim)->mesh().numTets(), 6 * 15 * 10 * 5 * 11 / 10);  // element growth <= 10%
+  EXPECT_TRUE(cutting::validate((*sim)->mesh()).ok());
+  EXPECT_EQ((*sim)->state().warnings, 0);
+}
+
+TEST(Shaving, NoCutWhileThePedalIsOff) {
+  auto scene = loadScene(writeSlabScene(false));
+  ASSERT_TRUE(scene.ok()) << scene.error();
+  auto sim = Simulation::create(*scene);
+  ASSERT_TRUE(sim.ok()) << sim.error();
+  const int elements = (*sim)->mesh().numTets();
+  for (int i = 0; i < 1300; ++i) (*sim)->step();
+  EXPECT_TRUE((*sim)->passes().empty());
+  EXPECT_EQ((*sim)->mesh().numTets(), elements);
+}
+
+}  // namespace
+}  // namespace hysim::engine
