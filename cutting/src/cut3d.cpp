@@ -767,7 +767,28 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
       // The face must lie in the surface, not just have its corners on it.
       const Vec3 a = w.x(key.v[0]), b = w.x(key.v[1]), c = w.x(key.v[2]);
       const double size = std::max({(b - a).norm(), (c - a).norm(), (c - b).norm()});
-      if (std::abs(surface.signedDistance((a + b + c) / 3.0)) > eps + 0.05 * size) continue;
+      const Vec3 centre = (a + b + c) / 3.0;
+      if (std::abs(surface.signedDistance(centre)) > eps + 0.05 * size) {
+        // On a curved surface a flat face with its corners on the surface lies off it by the
+        // sagitta (about size^2 / (8 R)), and a thin tet beside it may lie wholly on the far
+        // side of the surface. The face is still on the cut when the surface passes between
+        // the two tets there: the segment between their vertices opposite the face (or,
+        // where one of those is on the surface, between their centroids) crosses it near
+        // the face.
+        auto crossesNear = [&](const Vec3& p, const Vec3& q) {
+          CutSurface::Hit hit;
+          return surface.intersectSegment(p, q, eps, &hit) &&
+                 (hit.point - centre).norm() <= std::max(size, (q - p).norm());
+        };
+        auto centroid = [&](int t) {
+          const Tet tv = w.tet(t);
+          return Vec3((w.x(tv[0]) + w.x(tv[1]) + w.x(tv[2]) + w.x(tv[3])) / 4.0);
+        };
+        const int o0 = w.tet(use.tet[0])[use.opposite[0]], o1 = w.tet(use.tet[1])[use.opposite[1]];
+        const bool across = (!on[o0] && !on[o1] && crossesNear(w.x(o0), w.x(o1))) ||
+                            crossesNear(centroid(use.tet[0]), centroid(use.tet[1]));
+        if (!across) continue;
+      }
     }
     cutFaces.insert(key);
   }

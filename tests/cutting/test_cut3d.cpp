@@ -425,5 +425,66 @@ TEST(Cut3D, UterusPlaneCutQuality) {
   EXPECT_GT(st.mesh.numTets(), h.mesh.numTets());
 }
 
+// An open half-cylinder strip (radius 3.5 around the z axis line x = 0, y = -0.5, lower half,
+// z in [-6, 14]) dipping 3 mm into the top of the myoma (sphere around (0, -9, 4), radius 8):
+// its long edges lie above the myoma surface and its ends outside the myoma, so the cap of
+// tissue between the strip and the myoma surface is enclosed and must come off. The strip is
+// curved on the scale of the elements (edges ~4 mm): the flat faces through the crossings lie
+// off the surface by their sagitta, and they must still count as cut faces.
+TEST(Cut3D, UterusHalfCylinderStripSeparatesCap) {
+  const std::string path = std::string(HYSIM_SOURCE_DIR) + "/assets/uterus_myoma.msh";
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << "no " << path;
+  const auto mesh = readTetMesh(path);
+  ASSERT_TRUE(mesh.ok()) << mesh.error();
+  const double radius = 3.5, yAxis = -0.5, z0 = -6, z1 = 14;
+  const int nu = 16, nv = 20;
+  Positions X((nu + 1) * (nv + 1), 3);
+  Tris F(2 * nu * nv, 3);
+  for (int j = 0; j <= nv; ++j)
+    for (int i = 0; i <= nu; ++i) {
+      const double a = M_PI + M_PI * i / nu;
+      X.row(j * (nu + 1) + i) << radius * std::cos(a), yAxis + radius * std::sin(a), z0 + (z1 - z0) * j / nv;
+    }
+  int f = 0;
+  for (int j = 0; j < nv; ++j)
+    for (int i = 0; i < nu; ++i) {
+      const int v00 = j * (nu + 1) + i, v10 = v00 + 1, v01 = v00 + nu + 1, v11 = v01 + 1;
+      F.row(f++) << v00, v10, v11;
+      F.row(f++) << v00, v11, v01;
+    }
+  const CutSurface s = *CutSurface::triangles(X, F);
+  // Enclosed volume: inside the sphere, above the strip (|x| < radius), by midpoint sums.
+  const Vec3 centre(0, -9, 4);
+  const double rs = 8;
+  double analytic = 0;
+  const int n = 200;
+  const double hx = 2 * radius / n, hz = 2 * rs / n;
+  for (int i = 0; i < n; ++i)
+    for (int k = 0; k < n; ++k) {
+      const double x = -radius + (i + 0.5) * hx, z = centre.z() - rs + (k + 0.5) * hz;
+      const double r2 = rs * rs - x * x - (z - centre.z()) * (z - centre.z());
+      if (r2 <= 0) continue;
+      const double top = centre.y() + std::sqrt(r2), bottom = yAxis - std::sqrt(radius * radius - x * x);
+      if (top > bottom) analytic += (top - bottom) * hx * hz;
+    }
+  ASSERT_GT(analytic, 50.0);
+  ASSERT_LT(analytic, 200.0);
+  const double v0 = totalVolume(*mesh);
+  for (CutMethod method : {CutMethod::Standard, CutMethod::Hybrid}) {
+    SCOPED_TRACE(cutMethodName(method));
+    auto r = cut3d(*mesh, s, withMethod(method));
+    ASSERT_TRUE(r.ok()) << r.error();
+    const auto v = validate(r->mesh);
+    EXPECT_TRUE(v.ok()) << v.error();
+    EXPECT_NEAR(totalVolume(r->mesh), v0, (method == CutMethod::Standard ? 1e-9 : 1e-3) * v0);
+    const auto c = tetComponents(r->mesh);
+    ASSERT_EQ(c.count, 2);
+    const double cap = std::min(c.volume[0], c.volume[1]);
+    // The faceted myoma and the coarse elements make the cap smaller than the exact one.
+    EXPECT_GT(cap, 0.5 * analytic);
+    EXPECT_LT(cap, 1.3 * analytic);
+  }
+}
+
 }  // namespace
 }  // namespace hysim::cutting
