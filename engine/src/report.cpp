@@ -116,6 +116,8 @@ std::string reportJson(const RunReport& r) {
     e["duplicated_nodes"] = p.duplicated_nodes;
     e["cut_faces"] = p.cut_faces;
     e["components"] = p.components;
+    e["substeps"] = p.substeps;
+    e["added_mass_g"] = p.added_mass_g;
     if (p.cut_failed) e["failed"] = p.message;
     per_pass.push_back(e);
   }

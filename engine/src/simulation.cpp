@@ -341,6 +341,8 @@ void Simulation::finishPass() {
   rec.elements = mesh_.numTets();
   rec.nodes = mesh_.numNodes();
   rec.q_min = stats.q_min;
+  rec.substeps = model_.substeps;
+  rec.added_mass_g = model_.added_mass;
   rec.cut_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
   passes_.push_back(rec);
 }

@@ -196,6 +196,26 @@ TEST(Integrators, SameStaticEquilibrium) {
   EXPECT_LT(si.v.norm(), 1.0);
 }
 
+// A cap on the automatic substeps is met by adding mass where the frequency is highest,
+// and the model stays stable.
+TEST(Stability, MassScalingRespectsTheSubstepCap) {
+  const TetMesh mesh = testing::boxTetMesh(4, 3, 3, 1.0);
+  ModelOptions o = noGravity();
+  auto free_model = buildModel(mesh, {tissue(150e3)}, {0, 1, 2, 3}, o);
+  ASSERT_TRUE(free_model.ok());
+  ASSERT_GT(free_model->substeps, 3);
+  o.max_substeps = 3;
+  auto capped = buildModel(mesh, {tissue(150e3)}, {0, 1, 2, 3}, o);
+  ASSERT_TRUE(capped.ok());
+  EXPECT_LE(capped->substeps, 3);
+  EXPECT_GT(capped->added_mass, 0.0);
+  EXPECT_LE(capped->substep, 0.85 * capped->critical_dt * 1.0001);
+  State s = makeState(*capped, mesh);
+  for (int i = 0; i < mesh.numNodes(); ++i) s.v(i, 0) = 50.0 * std::sin(0.7 * i);
+  for (int i = 0; i < 1000; ++i) step(*capped, s, {});
+  EXPECT_EQ(s.warnings, 0);
+}
+
 TEST(Step, AllocatesNothing) {
   const TetMesh mesh = testing::boxTetMesh(4, 4, 4, 2.0);
   for (Integrator integrator : {Integrator::SymplecticEuler, Integrator::ImplicitEuler}) {

@@ -30,6 +30,8 @@ struct PassRecord {
   double sweep_area_mm2 = 0.0;  // area of the cut surface (the loop's sweep)
   int crossed_edges = 0, snapped_nodes = 0, split_edges = 0, duplicated_nodes = 0, cut_faces = 0;
   int components = 0;
+  int substeps = 0;          // of the rebuilt model
+  double added_mass_g = 0.0; // mass scaling needed to keep substeps within the cap
   bool cut_failed = false;   // the cut was refused (the mesh is left as it was)
   std::string message;
 };

@@ -32,6 +32,7 @@ struct ModelOptions {
   double dt = 1e-3;                            // s, fixed step
   Integrator integrator = Integrator::SymplecticEuler;
   int substeps = 0;                            // symplectic Euler; 0 = choose from the stability limit
+  int max_substeps = 32;                       // automatic substeps never exceed this (mass scaling, see Model)
   double stability_safety = 0.85;               // substep = safety * critical step when automatic
   int implicit_iterations = 8;                 // local/global iterations per implicit step
   double drag_per_s = 0.0;                     // alpha: mass-proportional damping (fluid drag), 1/s
@@ -80,6 +81,7 @@ struct Model {
   int substeps = 1;
   double critical_dt = 0.0;        // s, estimated stability limit of symplectic Euler
   double omega_max = 0.0;          // rad/s, estimated highest natural frequency
+  double added_mass = 0.0;         // g, added by selective mass scaling to respect max_substeps
 
   std::shared_ptr<const ImplicitSolver> implicit;  // set when integrator == ImplicitEuler
 };
