@@ -73,6 +73,9 @@ Result<RunReport> run(Simulation& sim, const RunOptions& options) {
   r.state_hash = sim.stateHash();
   r.warnings = sim.state().warnings;
   r.passes = sim.passes();
+  r.initial_myoma_mm3 = sim.initialMyomaVolume();
+  r.electrode_active_s = sim.electrodeActiveSeconds();
+  r.path_length_mm = sim.pathLengthMm();
   return r;
 }
 
@@ -121,6 +124,16 @@ std::string reportJson(const RunReport& r) {
     if (p.cut_failed) e["failed"] = p.message;
     per_pass.push_back(e);
   }
+  double myoma_removed = 0.0, removed = 0.0;
+  for (const PassRecord& p : r.passes) {
+    myoma_removed += p.removed_myoma_mm3;
+    removed += p.removed_mm3;
+  }
+  j["myoma_resected_mm3"] = myoma_removed;
+  j["myoma_resected_pct"] = r.initial_myoma_mm3 > 0.0 ? 100.0 * myoma_removed / r.initial_myoma_mm3 : 0.0;
+  j["healthy_removed_mm3"] = removed - myoma_removed;
+  j["electrode_active_s"] = r.electrode_active_s;
+  j["path_length_mm"] = r.path_length_mm;
   j["passes"] = r.passes.size();
   j["cut_ms"] = {{"median", percentile(cut_ms, 0.5)}, {"max", cut_ms.empty() ? 0.0 : *std::max_element(cut_ms.begin(), cut_ms.end())}};
   j["per_pass"] = per_pass;

@@ -142,6 +142,12 @@ Result<std::unique_ptr<Simulation>> Simulation::create(const Scene& scene) {
   loopPoints(s->loop_, s->pose_, s->wire_);  // sizes the wire buffers once
   s->previous_wire_ = s->wire_;
   if (Status st = s->setTopology(s->mesh_, nullptr, nullptr); !st.ok()) return Error{scene.path + ": " + st.error()};
+  for (const sim::Material& m : scene.materials) {
+    if (m.name != "myoma") continue;
+    for (int t = 0; t < s->mesh_.numTets(); ++t) {
+      if (s->mesh_.material[t] == m.label) s->initial_myoma_mm3_ += cutting::tetVolume(s->mesh_, t);
+    }
+  }
 
   if (!scene.tool_mesh_path.empty()) {
     auto tool = loadSurface(scene.tool_mesh_path, render::SurfaceMaterial::Tool);
@@ -192,7 +198,10 @@ bool Simulation::wireInTissue() {
 
 void Simulation::step() {
   // The pose for the end of this step drives the contact of this step.
+  const Eigen::Vector3d previous_tip = pose_.tip;
   pose_ = device_->read(state_.time + scene_.sim.dt).pose;
+  path_length_mm_ += (pose_.tip - previous_tip).norm();
+  if (pose_.pedal) electrode_active_s_ += scene_.sim.dt;
   computeContact();
   sim::StepInput input;
   input.external_force = &contact_force_;

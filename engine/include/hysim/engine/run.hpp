@@ -33,6 +33,9 @@ struct RunReport {
   double max_tool_force_n = 0.0;
   double wall_s = 0.0;
   std::vector<PassRecord> passes;  // shaving passes (cuts), in order
+  double initial_myoma_mm3 = 0.0;
+  double electrode_active_s = 0.0;
+  double path_length_mm = 0.0;
 };
 
 Result<RunReport> run(Simulation& simulation, const RunOptions& options);

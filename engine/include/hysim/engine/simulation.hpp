@@ -67,6 +67,10 @@ class Simulation {
   bool loopInTissue() const { return loop_in_tissue_; }
   const LoopGeometry& loop() const { return loop_; }
   int topologyVersion() const { return topology_version_; }
+  // Metrics of the run so far.
+  double initialMyomaVolume() const { return initial_myoma_mm3_; }  // mm^3, rest shape
+  double electrodeActiveSeconds() const { return electrode_active_s_; }
+  double pathLengthMm() const { return path_length_mm_; }         // of the scope tip
   // Puts back a state saved from this simulation (benchmarks restore one before each batch).
   // Same topology only; copies into the existing buffers.
   void restoreState(const sim::State& saved) { state_ = saved; }
@@ -107,6 +111,9 @@ class Simulation {
   bool cutting_ = false;
   int topology_version_ = 0;
   std::vector<PassRecord> passes_;
+  double initial_myoma_mm3_ = 0.0;
+  double electrode_active_s_ = 0.0;
+  double path_length_mm_ = 0.0;
 };
 
 // Loads a surface (OBJ, STL, PLY, glTF...) with assimp, triangulated, in millimetres.
