@@ -375,38 +375,15 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
       const CrossedEdge& ce = crossed[cand.edge];
       const int other = ce.a == n ? ce.b : ce.a;
       // Boundary faces around n: faces containing n used by one tet of its star.
-      std::vector<std::pair<FaceKey, Vec3>> faces;
-      std::vector<int> faceCount;
-      for (int s = starOff[n]; s < starOff[n + 1]; ++s) {
-        const int t = starTet[s];
-        const int ln = findLocal(w.tet(t), n);
-        const Tet tv = w.tet(t);
-        for (int f = 0; f < 4; ++f) {
-          if (f == ln) continue;
-          const int i0 = tv[kFace[f][0]], i1 = tv[kFace[f][1]], i2 = tv[kFace[f][2]];
-          const FaceKey key = makeFace(i0, i1, i2);
-          bool found = false;
-          for (size_t q = 0; q < faces.size(); ++q)
-            if (faces[q].first == key) {
-              ++faceCount[q];
-              found = true;
-            }
-          if (!found) {
-            faces.emplace_back(key, (w.x(i1) - w.x(i0)).cross(w.x(i2) - w.x(i0)));
-            faceCount.push_back(1);
-          }
-        }
-      }
       bool boundary = false, feature = false, boundaryEdge = false;
       Vec3 firstNormal = Vec3::Zero();
-      for (size_t q = 0; q < faces.size(); ++q) {
-        if (faceCount[q] != 1) continue;
-        const Vec3 nrm = faces[q].second.normalized();
-        if (!boundary) firstNormal = nrm;
+      Vec3 normalSum = Vec3::Zero();  // mean boundary normal at n (its tangent plane)
+      for (const BFace& bf : boundaryFacesOf(n)) {
+        if (!boundary) firstNormal = bf.normal;
+        normalSum += bf.normal;
         boundary = true;
-        if (nrm.dot(firstNormal) < cosFeature) feature = true;
-        const auto& v = faces[q].first.v;
-        if (v[0] == other || v[1] == other || v[2] == other) boundaryEdge = true;
+        if (bf.normal.dot(firstNormal) < cosFeature) feature = true;
+        if (bf.u == other || bf.v == other) boundaryEdge = true;
       }
       Vec3 target;
       bool ridgeSnap = false;
@@ -438,10 +415,7 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
         } else if (boundaryEdge) {
           target = crossingPoint(ce);
         } else {
-          Vec3 m = Vec3::Zero();
-          for (size_t q = 0; q < faces.size(); ++q)
-            if (faceCount[q] == 1) m += faces[q].second.normalized();
-          m.normalize();
+          const Vec3 m = normalSum.normalized();
           // Cut plane near n: the plane itself, or the plane of the hit triangle.
           const Vec3 cn = plane ? surface.planeNormal() : crossedNormal[cand.edge];
           const double dist = plane ? phi[n] : cn.dot(w.x(n) - ce.point);
