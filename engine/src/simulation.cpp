@@ -115,6 +115,10 @@ Status Simulation::setTopology(cutting::TetMesh rest_mesh, const sim::NodeVector
       }
     }
   }
+  if (on_cut_.size() != static_cast<size_t>(mesh_.numNodes())) on_cut_.assign(mesh_.numNodes(), 0);
+  for (size_t v = 0; v < surface_nodes_.size(); ++v) {
+    if (on_cut_[surface_nodes_[v]]) surface_material_[v] = render::SurfaceMaterial::Cut;
+  }
   for (int node : surface_nodes_) {
     if (!model_.fixed[node]) contact_nodes_.push_back(node);
   }
@@ -345,6 +349,19 @@ void Simulation::finishPass() {
   // If mapping the cut back to rest positions inverted anything (large deformation at the
   // cut), the current shape becomes the rest shape: the tissue relaxes there.
   if (!cutting::validate(rest_mesh).ok()) rest_mesh.X = x_kept;
+  // Nodes on a cut surface, this pass's and earlier ones', in the new numbering.
+  std::vector<std::uint8_t> on_cut(n, 0);
+  for (int i = 0; i < static_cast<int>(change.node_old_to_new.size()); ++i) {
+    const int j = change.node_old_to_new[i];
+    if (j >= 0 && i < static_cast<int>(on_cut_.size()) && on_cut_[i]) on_cut[j] = 1;
+  }
+  for (int c : change.cut_nodes) {
+    if (c >= 0 && c < n) on_cut[c] = 1;
+  }
+  on_cut_.assign(kept_nodes, 0);
+  for (int i = 0; i < n; ++i) {
+    if (new_index[i] >= 0) on_cut_[new_index[i]] = on_cut[i];
+  }
   if (Status st = setTopology(std::move(rest_mesh), &x_kept, &v_kept); !st.ok()) return fail(st.error());
   const cutting::MeshStats stats = cutting::computeStats(mesh_);
   rec.elements = mesh_.numTets();

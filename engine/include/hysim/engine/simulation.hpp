@@ -111,6 +111,7 @@ class Simulation {
   bool cutting_ = false;
   int topology_version_ = 0;
   std::vector<PassRecord> passes_;
+  std::vector<std::uint8_t> on_cut_;  // #N: node lies on a cut surface (drawn as cut tissue)
   double initial_myoma_mm3_ = 0.0;
   double electrode_active_s_ = 0.0;
   double path_length_mm_ = 0.0;
