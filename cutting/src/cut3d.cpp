@@ -62,6 +62,25 @@ struct CrossedEdge {
   bool alive = true;   // still crossed (neither end snapped)
 };
 
+// An end node of a crossed edge whose crossing lies within `limit` (fraction of the edge) of
+// it: the snap candidates, and the routing candidates. Nearest first, ties in edge order.
+struct EndCandidate {
+  double frac;
+  std::int32_t node, edge;
+};
+
+std::vector<EndCandidate> endCandidates(const std::vector<CrossedEdge>& crossed, double limit, bool alive_only) {
+  std::vector<EndCandidate> out;
+  for (int e = 0; e < static_cast<int>(crossed.size()); ++e) {
+    const CrossedEdge& c = crossed[e];
+    if (alive_only && !c.alive) continue;
+    if (c.t <= limit) out.push_back({c.t, c.a, e});
+    if (1.0 - c.t <= limit) out.push_back({1.0 - c.t, c.b, e});
+  }
+  std::stable_sort(out.begin(), out.end(), [](const EndCandidate& x, const EndCandidate& y) { return x.frac < y.frac; });
+  return out;
+}
+
 // Working mesh: the input arrays plus appended nodes and tets.
 struct Work {
   const TetMesh& in;
@@ -356,18 +375,7 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
                         : options.method == CutMethod::Snap ? 0.5
                                                             : 0.0;
   if (region > 0 && !crossed.empty()) {
-    struct Candidate {
-      double frac;
-      std::int32_t node, edge;
-    };
-    std::vector<Candidate> candidates;
-    for (int e = 0; e < static_cast<int>(crossed.size()); ++e) {
-      const auto& c = crossed[e];
-      if (c.t <= region) candidates.push_back({c.t, c.a, e});
-      if (1.0 - c.t <= region) candidates.push_back({1.0 - c.t, c.b, e});
-    }
-    std::stable_sort(candidates.begin(), candidates.end(),
-                     [](const Candidate& x, const Candidate& y) { return x.frac < y.frac; });
+    const std::vector<EndCandidate> candidates = endCandidates(crossed, region, /*alive_only=*/false);
     std::vector<std::uint8_t> refused(N0, 0);
     for (const auto& cand : candidates) {
       const int n = cand.node;
@@ -576,18 +584,8 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
   //     locally, off by at most through_node_fraction * |e| (measured along the edge).
   std::vector<std::uint8_t> approx;  // nodes treated as on the surface without moving
   if (options.method == CutMethod::Hybrid && options.through_node_fraction > 0 && !crossed.empty()) {
-    struct Near {
-      double frac;
-      std::int32_t node, edge;
-    };
-    std::vector<Near> near;
-    for (int e = 0; e < static_cast<int>(crossed.size()); ++e) {
-      const auto& c = crossed[e];
-      if (!c.alive) continue;
-      if (c.t < options.through_node_fraction) near.push_back({c.t, c.a, e});
-      if (1.0 - c.t < options.through_node_fraction) near.push_back({1.0 - c.t, c.b, e});
-    }
-    std::stable_sort(near.begin(), near.end(), [](const Near& x, const Near& y) { return x.frac < y.frac; });
+    const std::vector<EndCandidate> near =
+        endCandidates(crossed, std::nextafter(options.through_node_fraction, 0.0), /*alive_only=*/true);
     for (const auto& nr : near) {
       const int n = nr.node;
       if (on[n] || !crossed[nr.edge].alive) continue;
