@@ -145,6 +145,7 @@ Result<std::unique_ptr<Simulation>> Simulation::create(const Scene& scene) {
   s->loop_.drop_mm = scene.contact.loop_drop_mm;
   loopPoints(s->loop_, s->pose_, s->wire_);  // sizes the wire buffers once
   s->previous_wire_ = s->wire_;
+  s->sweep_.reserve(10000, static_cast<int>(s->wire_.rows()));  // a 10 s pass without allocating
   if (Status st = s->setTopology(s->mesh_, nullptr, nullptr); !st.ok()) return Error{scene.path + ": " + st.error()};
   for (const sim::Material& m : scene.materials) {
     if (m.name != "myoma") continue;

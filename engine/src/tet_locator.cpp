@@ -12,10 +12,12 @@ void TetLocator::build(const cutting::TetMesh& mesh, const sim::NodeVectors& x, 
   margin_ = margin_mm;
   built_x_ = x;
   const int nt = mesh.numTets();
-  cell_start_.clear();
-  cell_tets_.clear();
   dims_.setZero();
-  if (nt == 0 || x.rows() == 0) return;
+  if (nt == 0 || x.rows() == 0) {
+    cell_start_.clear();
+    cell_tets_.clear();
+    return;
+  }
   Eigen::Vector3d lo = x.colwise().minCoeff().transpose(), hi = x.colwise().maxCoeff().transpose();
   lo.array() -= margin_;
   hi.array() += margin_;
@@ -25,7 +27,10 @@ void TetLocator::build(const cutting::TetMesh& mesh, const sim::NodeVectors& x, 
   origin_ = lo;
   for (int c = 0; c < 3; ++c) dims_[c] = std::max(1, static_cast<int>(std::ceil((hi[c] - lo[c]) / cell_)));
   const long cells = static_cast<long>(dims_.x()) * dims_.y() * dims_.z();
-  std::vector<int> count(cells + 1, 0);
+  // Buffers keep their capacity between builds: a rebuild during a pass allocates nothing
+  // unless the grid grew.
+  std::vector<int>& count = cell_start_;
+  count.assign(static_cast<size_t>(cells) + 1, 0);
   auto cellRange = [&](int t, Eigen::Vector3i& a, Eigen::Vector3i& b) {
     Eigen::Vector3d tlo = x.row(mesh.T(t, 0)).transpose(), thi = tlo;
     for (int k = 1; k < 4; ++k) {
@@ -46,9 +51,9 @@ void TetLocator::build(const cutting::TetMesh& mesh, const sim::NodeVectors& x, 
         for (int i = a.x(); i <= b.x(); ++i) ++count[index(i, j, k) + 1];
   }
   for (long c = 0; c < cells; ++c) count[c + 1] += count[c];
-  cell_start_.assign(count.begin(), count.end());
   cell_tets_.resize(cell_start_.back());
-  std::vector<int> fill(cell_start_.begin(), cell_start_.end() - 1);
+  std::vector<int>& fill = fill_;
+  fill.assign(cell_start_.begin(), cell_start_.end() - 1);
   for (int t = 0; t < nt; ++t) {
     cellRange(t, a, b);
     for (int k = a.z(); k <= b.z(); ++k)

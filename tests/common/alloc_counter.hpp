@@ -1,6 +1,7 @@
 #pragma once
 // Counts heap allocations made while a scope is active, by interposing malloc (glibc).
-// Include in exactly one translation unit of a test executable (it defines malloc).
+// Exactly one translation unit of a test executable defines HYSIM_DEFINE_ALLOC_HOOKS before
+// including this header (that one defines malloc, calloc and realloc).
 #include <cstddef>
 
 extern "C" void* __libc_malloc(std::size_t);
@@ -18,6 +19,7 @@ struct AllocationCounter {
 };
 }  // namespace hysim::testing
 
+#ifdef HYSIM_DEFINE_ALLOC_HOOKS
 extern "C" void* malloc(std::size_t n) {
   if (hysim::testing::g_counting) ++hysim::testing::g_allocations;
   return __libc_malloc(n);
@@ -30,3 +32,4 @@ extern "C" void* realloc(void* p, std::size_t n) {
   if (hysim::testing::g_counting) ++hysim::testing::g_allocations;
   return __libc_realloc(p, n);
 }
+#endif  // HYSIM_DEFINE_ALLOC_HOOKS

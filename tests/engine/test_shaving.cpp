@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "alloc_counter.hpp"
 #include "box_mesh.hpp"
 #include "hysim/cutting/cut3d.hpp"
 #include "hysim/cutting/mesh_io.hpp"
@@ -74,6 +75,26 @@ TEST(Shaving, OnePassThroughASlabCutsOnExit) {
   EXPECT_LT((*sim)->mesh().numTets(), 6 * 15 * 10 * 5 * 11 / 10);  // element growth <= 10%
   EXPECT_TRUE(cutting::validate((*sim)->mesh()).ok());
   EXPECT_EQ((*sim)->state().warnings, 0);
+}
+
+// While the active loop moves through the tissue (entry at ~175 steps, exit at ~925) the
+// step allocates nothing: the sweep and the tet locator reuse their storage.
+TEST(Shaving, StepAllocatesNothingWhileCutting) {
+  auto scene = loadScene(writeSlabScene(true));
+  ASSERT_TRUE(scene.ok()) << scene.error();
+  auto sim = Simulation::create(*scene);
+  ASSERT_TRUE(sim.ok()) << sim.error();
+  for (int i = 0; i < 250; ++i) (*sim)->step();
+  ASSERT_TRUE((*sim)->loopInTissue());
+  long count = 0;
+  {
+    testing::AllocationCounter counter;
+    for (int i = 0; i < 300; ++i) (*sim)->step();
+    count = counter.count();
+  }
+  EXPECT_TRUE((*sim)->loopInTissue());
+  EXPECT_TRUE((*sim)->passes().empty());
+  EXPECT_EQ(count, 0);
 }
 
 TEST(Shaving, NoCutWhileThePedalIsOff) {

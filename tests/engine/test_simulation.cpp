@@ -1,6 +1,7 @@
 // The fixed-step loop on the default scene: determinism, contact, a sane run.
 #include <gtest/gtest.h>
 
+#define HYSIM_DEFINE_ALLOC_HOOKS  // this file defines the malloc hooks for the executable
 #include "alloc_counter.hpp"
 #include "hysim/engine/run.hpp"
 #include "hysim/engine/scene.hpp"

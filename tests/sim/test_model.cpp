@@ -3,6 +3,7 @@
 
 #include <cmath>
 
+#define HYSIM_DEFINE_ALLOC_HOOKS  // this file defines the malloc hooks for the executable
 #include "alloc_counter.hpp"
 #include "box_mesh.hpp"
 #include "hysim/sim/model.hpp"

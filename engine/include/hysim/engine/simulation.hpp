@@ -41,8 +41,9 @@ class Simulation {
   // Loads the meshes named by the scene, anchors nodes, builds the tissue model.
   static Result<std::unique_ptr<Simulation>> create(const Scene& scene);
 
-  // Advances one fixed step. Allocates nothing, except on the step a shaving pass ends
-  // (the loop leaves the tissue), when the cut changes the topology.
+  // Advances one fixed step. Allocates nothing, also while the loop cuts through tissue,
+  // except on the step a shaving pass ends (the loop leaves the tissue), when the cut
+  // changes the topology.
   void step();
 
   // Fills a snapshot for the renderer. Reuses the snapshot's buffers (no allocation after

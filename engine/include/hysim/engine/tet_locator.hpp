@@ -29,6 +29,7 @@ class TetLocator {
   Eigen::Vector3i dims_{0, 0, 0};
   std::vector<int> cell_start_;  // #cells + 1
   std::vector<int> cell_tets_;
+  std::vector<int> fill_;        // build scratch
   sim::NodeVectors built_x_;
   double margin_ = 1.0;
 };

@@ -27,7 +27,10 @@ void loopPoints(const LoopGeometry& loop, const haptics::ToolPose& pose, Eigen::
 // 2*segments triangles, appended to X (#V x 3) and F (#F x 3).
 class Sweep {
  public:
-  void clear();
+  void clear();  // keeps the storage
+  // Room for `rows` wire positions of `row_size` points: advance() then allocates nothing
+  // until a sweep grows longer than that.
+  void reserve(int rows, int row_size) { points_.reserve(static_cast<size_t>(rows) * row_size); }
   bool empty() const { return num_quads_ == 0; }
   // Appends the strip between the last wire position and `wire` (the first call only records
   // the position).
