@@ -879,68 +879,24 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
   }
   std::sort(change.added_elements.begin(), change.added_elements.end());
 
-  // 5. Local optimisation (hybrid).
-  if (options.method == CutMethod::Hybrid && options.optimize.enabled && !cutNodes.empty() &&
-      options.optimize.rings > 0) {
+  std::vector<std::uint8_t> peeled;  // #M1: slivers the optimisation removed
+  // 5. Local optimisation (hybrid), from the nodes the cut created, moved or separated.
+  if (options.method == CutMethod::Hybrid && options.optimize.enabled && !cutNodes.empty()) {
     const auto optStart = std::chrono::steady_clock::now();
-    // Stars of the nodes up to `rings` edge steps from the cut, from the input's node -> tet
-    // lists and the fragments of the split tets (only what the cut touched).
-    LocalStars stars;
-    std::vector<std::int32_t> star;
-    auto starOf = [&](int n) {  // n < N0 and not on the cut, so never renumbered
-      star.clear();
-      for (int s = starOff[n]; s < starOff[n + 1]; ++s) {
-        const int o = starTet[s];
-        if (localOf[o] < 0) {
-          star.push_back(o);
-        } else {
-          for (int f : fragments[localOf[o]])
-            if (out.T(f, 0) == n || out.T(f, 1) == n || out.T(f, 2) == n || out.T(f, 3) == n) star.push_back(f);
-        }
-      }
-    };
-    auto boundaryStar = [&](int n) {
-      std::vector<FaceKey> faces;
-      for (int t : star)
-        for (int f = 0; f < 4; ++f) {
-          const FaceKey k = makeFace(out.T(t, kFace[f][0]), out.T(t, kFace[f][1]), out.T(t, kFace[f][2]));
-          if (k.v[0] != n && k.v[1] != n && k.v[2] != n) continue;
-          const auto it = std::find(faces.begin(), faces.end(), k);
-          if (it == faces.end()) {
-            faces.push_back(k);
-          } else {
-            faces.erase(it);
-          }
-        }
-      return !faces.empty();
-    };
-    std::unordered_set<std::int32_t> seen(cutNodes.begin(), cutNodes.end());
-    std::vector<std::int32_t> frontier;
-    for (int t : local)
-      for (int k = 0; k < 4; ++k) {
-        const int v = out.T(t, k);
-        if (v < N0 && !on[v] && seen.insert(v).second) frontier.push_back(v);
-      }
-    stars.offset.push_back(0);
-    for (int ring = 1; ring <= options.optimize.rings && !frontier.empty(); ++ring) {
-      std::vector<std::int32_t> next;
-      for (int n : frontier) {
-        starOf(n);
-        if (ring < options.optimize.rings)
-          for (int t : star)
-            for (int k = 0; k < 4; ++k) {
-              const int v = out.T(t, k);
-              if (v < N0 && !on[v] && seen.insert(v).second) next.push_back(v);
-            }
-        if (boundaryStar(n)) continue;
-        stars.nodes.push_back(n);
-        stars.tets.insert(stars.tets.end(), star.begin(), star.end());
-        stars.offset.push_back(static_cast<std::int32_t>(stars.tets.size()));
-      }
-      frontier.swap(next);
-    }
+    CutRegion region;
+    region.surface = &surface;
+    region.eps = eps;
+    region.on_cut.assign(on.begin(), on.end());
+    region.on_cut.resize(N1, 1);
+    region.seeds = cutNodes;
+    region.seeds.insert(region.seeds.end(), moved.begin(), moved.end());
     const size_t before = moved.size();
-    optimizeLocal3D(out, stars, options.optimize, &moved, &report.optimize_iterations);
+    OptimizeCounts counts;
+    optimizeAroundCut(out, region, options.optimize, &moved, &peeled, &counts);
+    report.optimize_iterations = counts.iterations;
+    report.peeled_elements = counts.peeled;
+    report.collapsed_edges = counts.collapsed;
+    report.peeled_volume = counts.peeled_volume;
     report.optimized_nodes = static_cast<int>(moved.size() - before);
     report.optimize_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - optStart).count();
   }
@@ -951,12 +907,14 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
     if (n < N0) change.moved_nodes.push_back(n);
   change.cut_nodes = cutNodes;
 
-  if (deleting) {
-    // Compact: drop deleted tets and the nodes no longer used.
+  const bool anyPeeled = std::find(peeled.begin(), peeled.end(), 1) != peeled.end();
+  if (deleting || anyPeeled) {
+    // Compact: drop deleted and peeled tets and the nodes no longer used.
+    auto dropped = [&](int t) { return (t < M0 && deleting && deleted[t]) || (anyPeeled && peeled[t]); };
     std::vector<std::int32_t> tetMap(M1, -1), nodeMap(N1, -1);
     int mt = 0;
     for (int t = 0; t < M1; ++t)
-      if (!(t < M0 && deleted[t])) tetMap[t] = mt++;
+      if (!dropped(t)) tetMap[t] = mt++;
     for (int t = 0; t < M1; ++t)
       if (tetMap[t] >= 0)
         for (int k = 0; k < 4; ++k) nodeMap[out.T(t, k)] = 1;
@@ -976,22 +934,34 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
     out = std::move(compact);
     for (int i = 0; i < N0; ++i) change.node_old_to_new[i] = nodeMap[i];
     for (int t = 0; t < M0; ++t) {
-      change.element_old_to_new[t] = tetMap[t];
-      if (tetMap[t] < 0) change.removed_elements.push_back(t);
+      const int was = change.element_old_to_new[t];
+      change.element_old_to_new[t] = was >= 0 ? tetMap[was] : -1;
+      if (was >= 0 && tetMap[was] < 0) change.removed_elements.push_back(t);
     }
-    auto remapList = [&](std::vector<std::int32_t>& list) {
+    std::sort(change.removed_elements.begin(), change.removed_elements.end());
+    auto remapList = [&](std::vector<std::int32_t>& list, const std::vector<std::int32_t>& map) {
       std::vector<std::int32_t> kept;
       for (int n : list)
-        if (nodeMap[n] >= 0) kept.push_back(nodeMap[n]);
+        if (map[n] >= 0) kept.push_back(map[n]);
       list = kept;
     };
-    remapList(change.cut_nodes);
+    remapList(change.cut_nodes, nodeMap);
+    remapList(change.moved_nodes, nodeMap);
+    remapList(change.added_elements, tetMap);
     for (auto& nn : change.new_nodes) nn.id = nodeMap[nn.id];
     change.new_nodes.erase(std::remove_if(change.new_nodes.begin(), change.new_nodes.end(),
                                           [](const NewNode& nn) { return nn.id < 0; }),
                            change.new_nodes.end());
-    for (auto& f : change.cut_faces)
-      for (auto& v : f) v = nodeMap[v];
+    std::vector<std::array<std::int32_t, 3>> faces;
+    for (auto f : change.cut_faces) {
+      bool keep = true;
+      for (auto& v : f) {
+        v = nodeMap[v];
+        keep = keep && v >= 0;
+      }
+      if (keep) faces.push_back(f);
+    }
+    change.cut_faces = faces;
   }
   change.new_num_nodes = out.numNodes();
   change.new_num_elements = out.numTets();

@@ -1,10 +1,18 @@
 // Local optimisation of a tet mesh around a cut (the paper's 2D regularisation carried to
-// 3D, its "future work"). Only nodes near the cut take part, and only those with a poor
-// element around them; cut and boundary nodes stay. Each candidate move (a spring step
-// toward the local mean edge length, or a push away from the face opposite the node in its
-// worst element, with step halving) is kept only if no incident tet inverts and the worst
-// incident q* increases, so the local minimum quality never drops. Everything is local:
-// the caller hands in the stars of the candidate nodes (no whole-mesh pass).
+// 3D, its "future work"). Only nodes of poor elements near the cut take part. Each node moves
+// within what keeps the cut and the boundary where they are:
+//  - interior nodes freely, but never onto or across the cut surface (sides are kept);
+//  - nodes on the cut only within the cut plane (plane cuts; on a curved surface only where
+//    all their boundary faces are coplanar), and only if every boundary face around them
+//    lies in the cut (rim nodes, where the cut meets the outer boundary, stay);
+//  - other boundary nodes only where their boundary is flat (every face normal within
+//    boundary_flat_deg of the area-weighted normal), and only perpendicular to that normal:
+//    the volume of a mesh is linear in one node's position with gradient (1/3) * the sum of
+//    its boundary faces' area vectors, so such a move keeps the volume exactly.
+// Candidate moves (ascent along the gradient of the worst incident element's q*, a damped
+// spring step toward the local mean edge length, a push away from the face opposite the
+// node in its worst element; each tried at decreasing lengths) are kept only if no incident
+// tet inverts and the worst incident q* rises: the local minimum quality never drops.
 #include <algorithm>
 #include <cmath>
 #include <vector>
@@ -14,60 +22,461 @@
 #include "optimize3d_internal.hpp"
 
 namespace hysim::cutting {
+namespace {
 
-void optimizeLocal3D(TetMesh& mesh, const LocalStars& stars, const Optimize3DOptions& options,
-                     std::vector<std::int32_t>* moved, int* iterations) {
-  using Vec3 = Eigen::Vector3d;
-  const int count = static_cast<int>(stars.nodes.size());
-  if (iterations) *iterations = 0;
-  if (count == 0) return;
+using Vec3 = Eigen::Vector3d;
+constexpr int kFace[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
+
+enum class Freedom { Free, Plane, Fixed };
+struct Constraint {
+  Freedom kind = Freedom::Fixed;
+  Vec3 normal = Vec3::Zero();  // Plane: moves are perpendicular to it
+};
+
+}  // namespace
+
+void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DOptions& options,
+                       std::vector<std::int32_t>* moved, std::vector<std::uint8_t>* dead, OptimizeCounts* counts) {
+  const int N = mesh.numNodes(), M = mesh.numTets();
+  dead->assign(M, 0);
+  if (region.seeds.empty() || N == 0) return;
+  const bool plane = region.surface && region.surface->isPlane();
+  const double cosFlat = std::cos(options.boundary_flat_deg * M_PI / 180.0);
+
+  // Node -> tets of the whole mesh (one O(#T) pass; everything else is local).
+  // Rebuilt after edge collapses (live tets only).
+  std::vector<std::int32_t> off(N + 1, 0), star(4 * static_cast<size_t>(M));
+  auto buildStars = [&]() {
+    std::fill(off.begin(), off.end(), 0);
+    for (int t = 0; t < M; ++t)
+      if (!(*dead)[t])
+        for (int k = 0; k < 4; ++k) ++off[mesh.T(t, k) + 1];
+    for (int i = 0; i < N; ++i) off[i + 1] += off[i];
+    std::vector<std::int32_t> fill(off.begin(), off.end() - 1);
+    for (int t = 0; t < M; ++t)
+      if (!(*dead)[t])
+        for (int k = 0; k < 4; ++k) star[fill[mesh.T(t, k)]++] = t;
+  };
+  buildStars();
+  // Peeling and collapses change the volume; together they may change it by at most
+  // volume_budget of the mesh's volume.
+  double budget = 0;
+  for (int t = 0; t < M; ++t) budget += tetVolume(mesh, t);
+  budget *= options.volume_budget;
   auto pos = [&](int i) -> Vec3 { return mesh.X.row(i).transpose(); };
-  double scale = 0;
-  // Worst q* around node n placed at `at`; sets *inverted when an element would invert and
-  // *worstTet to the (star index of the) worst element.
-  auto worst = [&](int j, const Vec3& at, bool* inverted, int* worstTet) {
-    const int n = stars.nodes[j];
+  auto tetQ = [&](int t) {
+    return radiusRatio(pos(mesh.T(t, 0)), pos(mesh.T(t, 1)), pos(mesh.T(t, 2)), pos(mesh.T(t, 3)));
+  };
+  // Quality of tet t with node n placed at y; negative when it would invert or go flat.
+  auto tetQAt = [&](int t, int n, const Vec3& y) {
+    Vec3 p[4];
+    for (int k = 0; k < 4; ++k) p[k] = mesh.T(t, k) == n ? y : pos(mesh.T(t, k));
+    if (!((p[1] - p[0]).dot((p[2] - p[0]).cross(p[3] - p[0])) > 0)) return -1.0;
+    return radiusRatio(p[0], p[1], p[2], p[3]);
+  };
+  auto starWorst = [&](int n, const Vec3& y, int* worstTet) {
     double q = 1.0;
-    for (int s = stars.offset[j]; s < stars.offset[j + 1]; ++s) {
-      const int t = stars.tets[s];
-      Vec3 p[4];
-      for (int k = 0; k < 4; ++k) p[k] = mesh.T(t, k) == n ? at : pos(mesh.T(t, k));
-      if (!((p[1] - p[0]).dot((p[2] - p[0]).cross(p[3] - p[0])) > 0)) {
-        *inverted = true;
-        return 0.0;
-      }
-      const double qt = radiusRatio(p[0], p[1], p[2], p[3]);
+    for (int s = off[n]; s < off[n + 1]; ++s) {
+      if ((*dead)[star[s]]) continue;
+      const double qt = tetQAt(star[s], n, y);
       if (qt < q) {
         q = qt;
-        if (worstTet) *worstTet = t;
+        if (worstTet) *worstTet = star[s];
+        if (qt < 0) return qt;
       }
     }
     return q;
   };
-  std::vector<std::uint8_t> didMove(count, 0);
-  // Work list: the nodes with a poor element around them; a node that cannot improve drops out.
-  std::vector<std::int32_t> work;
-  for (int j = 0; j < count; ++j) {
-    bool inv = false;
-    if (worst(j, pos(stars.nodes[j]), &inv, nullptr) < options.quality_target && !inv) work.push_back(j);
+  // Where node n may move (see the file comment).
+  struct BFace {
+    std::int32_t u, v;
+    Vec3 area;  // outward area vector (x2 the area)
+    int count;
+  };
+  std::vector<BFace> faces;
+  auto constraintOf = [&](int n) {
+    Constraint c;
+    faces.clear();
+    for (int s = off[n]; s < off[n + 1]; ++s) {
+      const int t = star[s];
+      if ((*dead)[t]) continue;
+      int ln = 0;
+      while (mesh.T(t, ln) != n) ++ln;
+      for (int f = 0; f < 4; ++f) {
+        if (f == ln) continue;
+        const int i0 = mesh.T(t, kFace[f][0]), i1 = mesh.T(t, kFace[f][1]), i2 = mesh.T(t, kFace[f][2]);
+        std::int32_t o[2], m = 0;
+        for (int v : {i0, i1, i2})
+          if (v != n) o[m++] = v;
+        if (o[0] > o[1]) std::swap(o[0], o[1]);
+        bool found = false;
+        for (auto& bf : faces)
+          if (bf.u == o[0] && bf.v == o[1]) {
+            ++bf.count;
+            found = true;
+          }
+        if (!found) faces.push_back({o[0], o[1], (pos(i1) - pos(i0)).cross(pos(i2) - pos(i0)), 1});
+      }
+    }
+    Vec3 sum = Vec3::Zero();
+    bool boundary = false, allCut = true;
+    for (const auto& bf : faces) {
+      if (bf.count != 1) continue;
+      boundary = true;
+      sum += bf.area;
+      allCut = allCut && region.on_cut[bf.u] && region.on_cut[bf.v];
+    }
+    const bool onCut = region.on_cut[n] != 0;
+    if (onCut) {
+      if (!options.move_cut_nodes || (boundary && !allCut)) return c;  // rim node (or off)
+      if (plane) {
+        c.kind = Freedom::Plane;
+        c.normal = region.surface->planeNormal();
+        return c;
+      }
+      if (!boundary || sum.norm() == 0) return c;
+      c.normal = sum.normalized();
+      for (const auto& bf : faces)
+        if (bf.count == 1 && bf.area.normalized().dot(c.normal) < 1.0 - 1e-9) return c;
+      c.kind = Freedom::Plane;
+      return c;
+    }
+    if (!boundary) {
+      c.kind = Freedom::Free;
+      return c;
+    }
+    if (!options.move_boundary_nodes || sum.norm() == 0) return c;
+    c.normal = sum.normalized();
+    for (const auto& bf : faces)
+      if (bf.count == 1 && bf.area.normalized().dot(c.normal) < cosFlat) return c;
+    c.kind = Freedom::Plane;
+    return c;
+  };
+  // A node off the cut stays strictly on its side of the surface.
+  auto sideKept = [&](int n, const Vec3& x, const Vec3& y) {
+    if (region.on_cut[n] || region.surface == nullptr) return true;
+    if (plane) {
+      const Vec3 pn = region.surface->planeNormal(), pp = region.surface->planePoint();
+      const double a = pn.dot(x - pp), b = pn.dot(y - pp);
+      return a * b > 0 && std::abs(b) > region.eps;
+    }
+    CutSurface::Hit hit;
+    return !region.surface->intersectSegment(x, y, region.eps, &hit) &&
+           std::abs(region.surface->signedDistance(y)) > region.eps;
+  };
+
+  // Peeling: a sliver (q* below peel_quality) with a face on the boundary is removed when
+  // the mesh stays manifold: the boundary faces around each of its nodes still form one
+  // closed loop (a disc), or the node had no other tet (it goes with the sliver). Its volume (tiny: it is flat) is lost.
+  std::vector<std::int32_t> link;  // scratch: link edges of a node, as pairs
+  auto boundaryFaceCount = [&](int t) {
+    int count = 0;
+    for (int f = 0; f < 4; ++f) {
+      const int a = mesh.T(t, kFace[f][0]), b = mesh.T(t, kFace[f][1]), c = mesh.T(t, kFace[f][2]);
+      bool shared = false;
+      for (int s = off[a]; s < off[a + 1] && !shared; ++s) {
+        const int u = star[s];
+        if (u == t || (*dead)[u]) continue;
+        int hits = 0;
+        for (int k = 0; k < 4; ++k) hits += mesh.T(u, k) == b || mesh.T(u, k) == c;
+        shared = hits == 2;
+      }
+      count += shared ? 0 : 1;
+    }
+    return count;
+  };
+  // The tets around v (live ones from the node->tet lists, plus `extra`).
+  auto liveStar = [&](int v, std::vector<std::int32_t>& out, const std::vector<std::int32_t>* extra) {
+    out.clear();
+    for (int s = off[v]; s < off[v + 1]; ++s)
+      if (!(*dead)[star[s]]) out.push_back(star[s]);
+    if (extra)
+      for (int t : *extra)
+        if (!(*dead)[t]) out.push_back(t);
+  };
+  // Is the neighbourhood of v (tets `around`) manifold: every face used by at most two tets,
+  // and the boundary faces around v one closed loop (or none: interior)? No tets: the node
+  // goes away (compacted), which is fine.
+  auto discAround = [&](int v, const std::vector<std::int32_t>& around) {
+    link.clear();
+    if (around.empty()) return true;
+    for (int t : around) {
+      int lv = 0;
+      while (mesh.T(t, lv) != v) ++lv;
+      for (int f = 0; f < 4; ++f) {
+        if (f == lv) continue;
+        std::int32_t o[2], m = 0;
+        for (int k = 0; k < 3; ++k)
+          if (mesh.T(t, kFace[f][k]) != v) o[m++] = mesh.T(t, kFace[f][k]);
+        int uses = 0;
+        for (int u : around) {
+          int hits = 0;
+          for (int k = 0; k < 4; ++k) hits += mesh.T(u, k) == o[0] || mesh.T(u, k) == o[1];
+          uses += hits == 2;
+        }
+        if (uses > 2) return false;
+        if (uses == 1) {
+          link.push_back(o[0]);
+          link.push_back(o[1]);
+        }
+      }
+    }
+    if (link.empty()) return true;  // interior node
+    // One closed loop: every link vertex has degree 2, and walking from one edge visits all.
+    const size_t edges = link.size() / 2;
+    for (size_t i = 0; i < link.size(); ++i) {
+      int degree = 0;
+      for (size_t j = 0; j < link.size(); ++j) degree += link[j] == link[i];
+      if (degree != 2) return false;
+    }
+    size_t visited = 1;
+    std::int32_t start = link[0], at = link[1];
+    size_t prevEdge = 0;
+    while (at != start && visited <= edges) {
+      size_t next = edges;
+      for (size_t e = 0; e < edges && next == edges; ++e)
+        if (e != prevEdge && (link[2 * e] == at || link[2 * e + 1] == at)) next = e;
+      if (next == edges) return false;
+      at = link[2 * next] == at ? link[2 * next + 1] : link[2 * next];
+      prevEdge = next;
+      ++visited;
+    }
+    return at == start && visited == edges;
+  };
+  std::vector<std::int32_t> around;
+  auto peel = [&]() {
+    if (!(options.peel_quality > 0)) return;
+    std::vector<std::int32_t> candidates;
+    for (int n : region.seeds)
+      for (int s = off[n]; s < off[n + 1]; ++s)
+        if (!(*dead)[star[s]] && tetQ(star[s]) < options.peel_quality) candidates.push_back(star[s]);
+    std::sort(candidates.begin(), candidates.end());
+    candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
+    for (bool again = true; again;) {
+      again = false;
+      for (int t : candidates) {
+        if ((*dead)[t] || boundaryFaceCount(t) == 0 || tetVolume(mesh, t) > budget) continue;
+        (*dead)[t] = 1;
+        bool ok = true;
+        for (int k = 0; k < 4 && ok; ++k) {
+          liveStar(mesh.T(t, k), around, nullptr);
+          ok = discAround(mesh.T(t, k), around);
+        }
+        if (!ok) {
+          (*dead)[t] = 0;
+          continue;
+        }
+        again = true;
+        budget -= tetVolume(mesh, t);
+        if (counts) {
+          ++counts->peeled;
+          counts->peeled_volume += tetVolume(mesh, t);
+        }
+      }
+    }
+  };
+  peel();
+
+  // Edge collapse on the cut: an edge with an end on the cut that is short (below
+  // collapse_fraction of its tet's mean edge) or belongs to a poor tet (q* below
+  // quality_target) is collapsed into its end on the cut, which keeps its place (so the cut
+  // stays where it is): the tets around the edge go, the other tets of the collapsed node
+  // take the kept one. Kept only if no tet inverts, the worst q* there rises (short edges:
+  // does not fall), the volume changes by at most collapse_volume_fraction of the star and
+  // within the budget, no two tets coincide and the mesh stays manifold. The node->tet lists are stale for the two ends until the next batch, so
+  // within a batch they take part in no other collapse.
+  auto collapseEdges = [&]() {
+    if (!(options.collapse_fraction > 0)) return;
+    std::vector<std::uint8_t> locked(N, 0);
+    std::vector<std::int32_t> dying, changing, vstar, keyA, keyB;
+    struct Cand {
+      double len;
+      std::int32_t u, v;
+      bool shortEdge;
+    };
+    for (int batch = 0; batch < 3; ++batch) {
+      std::vector<Cand> cands;
+      std::vector<std::int32_t> seen;
+      for (int n : region.seeds)
+        for (int s = off[n]; s < off[n + 1]; ++s) seen.push_back(star[s]);
+      std::sort(seen.begin(), seen.end());
+      seen.erase(std::unique(seen.begin(), seen.end()), seen.end());
+      for (int t : seen) {
+        if ((*dead)[t]) continue;
+        const double q = tetQ(t);
+        double mean = 0;
+        for (int a = 0; a < 4; ++a)
+          for (int b = a + 1; b < 4; ++b) mean += (pos(mesh.T(t, a)) - pos(mesh.T(t, b))).norm() / 6.0;
+        for (int a = 0; a < 4; ++a)
+          for (int b = a + 1; b < 4; ++b) {
+            const int x = mesh.T(t, a), y = mesh.T(t, b);
+            const double len = (pos(x) - pos(y)).norm();
+            const bool shortEdge = len < options.collapse_fraction * mean;
+            if (!shortEdge && q >= options.quality_target) continue;
+            if (region.on_cut[y]) cands.push_back({len, x, y, shortEdge});
+            if (region.on_cut[x]) cands.push_back({len, y, x, shortEdge});
+          }
+      }
+      std::sort(cands.begin(), cands.end(), [](const Cand& p, const Cand& q) {
+        return p.len != q.len ? p.len < q.len : p.u != q.u ? p.u < q.u : p.v < q.v;
+      });
+      int done = 0;
+      for (const Cand& c : cands) {
+        const int u = c.u, v = c.v;
+        if (locked[u] || locked[v]) continue;
+        dying.clear();
+        changing.clear();
+        double oldMin = 1.0, newMin = 1.0;
+        for (int s = off[u]; s < off[u + 1]; ++s) {
+          const int t = star[s];
+          if ((*dead)[t]) continue;
+          bool hasV = false;
+          for (int k = 0; k < 4; ++k) hasV = hasV || mesh.T(t, k) == v;
+          (hasV ? dying : changing).push_back(t);
+          oldMin = std::min(oldMin, tetQ(t));
+        }
+        if (dying.empty()) continue;  // not an edge any more
+        bool ok = true;
+        for (int t : changing) {
+          const double q = tetQAt(t, u, pos(v));
+          if (q < 0) {
+            ok = false;
+            break;
+          }
+          newMin = std::min(newMin, q);
+        }
+        if (!ok) continue;
+        // Volume: the removed tets and the change of the others, against u's star.
+        double before = 0, after = 0;
+        for (int t : dying) before += tetVolume(mesh, t);
+        for (int t : changing) {
+          before += tetVolume(mesh, t);
+          Vec3 p[4];
+          for (int k = 0; k < 4; ++k) p[k] = mesh.T(t, k) == u ? pos(v) : pos(mesh.T(t, k));
+          after += (p[1] - p[0]).dot((p[2] - p[0]).cross(p[3] - p[0])) / 6.0;
+        }
+        const double change = std::abs(after - before);
+        if (change > options.collapse_volume_fraction * before || change > budget) continue;
+        if (c.shortEdge ? newMin < oldMin : !(newMin > oldMin)) continue;
+        // No changed tet may coincide with a tet already around v.
+        liveStar(v, vstar, nullptr);
+        for (int t : changing) {
+          keyA.assign({mesh.T(t, 0), mesh.T(t, 1), mesh.T(t, 2), mesh.T(t, 3)});
+          std::replace(keyA.begin(), keyA.end(), u, v);
+          std::sort(keyA.begin(), keyA.end());
+          for (int w : vstar) {
+            if (std::find(dying.begin(), dying.end(), w) != dying.end()) continue;
+            keyB.assign({mesh.T(w, 0), mesh.T(w, 1), mesh.T(w, 2), mesh.T(w, 3)});
+            std::sort(keyB.begin(), keyB.end());
+            if (keyA == keyB) ok = false;
+          }
+        }
+        if (!ok) continue;
+        // Apply, check manifoldness around v and the other nodes of the removed tets, or undo.
+        for (int t : dying) (*dead)[t] = 1;
+        for (int t : changing)
+          for (int k = 0; k < 4; ++k)
+            if (mesh.T(t, k) == u) mesh.T(t, k) = v;
+        liveStar(v, around, &changing);
+        ok = discAround(v, around);
+        for (size_t i = 0; i < dying.size() && ok; ++i)
+          for (int k = 0; k < 4 && ok; ++k) {
+            const int w = mesh.T(dying[i], k);
+            if (w == u || w == v) continue;
+            liveStar(w, around, nullptr);
+            ok = discAround(w, around);
+          }
+        if (!ok) {
+          for (int t : dying) (*dead)[t] = 0;
+          for (int t : changing)
+            for (int k = 0; k < 4; ++k)
+              if (mesh.T(t, k) == v) mesh.T(t, k) = u;
+          continue;
+        }
+        locked[u] = locked[v] = 1;
+        budget -= change;
+        ++done;
+        if (counts) {
+          ++counts->collapsed;
+        }
+      }
+      if (done == 0) break;
+      buildStars();
+      std::fill(locked.begin(), locked.end(), 0);
+    }
+  };
+  collapseEdges();
+
+  // Nodes up to `rings` edge steps from the seeds may move.
+  std::vector<std::int8_t> ring(N, -1);
+  {
+    std::vector<std::int32_t> frontier, next;
+    for (int n : region.seeds)
+      if (n >= 0 && n < N && ring[n] < 0) {
+        ring[n] = 0;
+        frontier.push_back(n);
+      }
+    for (int r = 1; r <= options.rings && !frontier.empty(); ++r) {
+      next.clear();
+      for (int n : frontier)
+        for (int s = off[n]; s < off[n + 1]; ++s)
+          for (int k = 0; k < 4; ++k) {
+            const int v = mesh.T(star[s], k);
+            if (ring[v] < 0) {
+              ring[v] = static_cast<std::int8_t>(r);
+              next.push_back(v);
+            }
+          }
+      frontier.swap(next);
+    }
   }
+  // Work list: the nodes of poor elements around the seeds.
+  std::vector<std::int32_t> stamp(N, -1), work;
+  auto addBadAround = [&](int n, int round) {
+    for (int s = off[n]; s < off[n + 1]; ++s) {
+      const int t = star[s];
+      if ((*dead)[t] || tetQ(t) >= options.quality_target) continue;
+      for (int k = 0; k < 4; ++k) {
+        const int v = mesh.T(t, k);
+        if (ring[v] >= 0 && stamp[v] != round) {
+          stamp[v] = round;
+          work.push_back(v);
+        }
+      }
+    }
+  };
+  for (int n : region.seeds)
+    if (n >= 0 && n < N) addBadAround(n, 0);
+  std::vector<std::uint8_t> didMove(N, 0);
+  std::vector<std::int32_t> movedNow;
   int it = 0;
   for (; it < options.max_iterations && !work.empty(); ++it) {
-    double largest = 0;
-    std::vector<std::int32_t> keep;
-    for (int j : work) {
-      const int n = stars.nodes[j];
+    double largest = 0, scale = 0;
+    movedNow.clear();
+    for (int n : work) {
+      const Constraint c = constraintOf(n);
+      if (c.kind == Freedom::Fixed) continue;
       const Vec3 x = pos(n);
-      bool inv = false;
       int wt = -1;
-      const double before = worst(j, x, &inv, &wt);
-      if (inv || before >= options.quality_target || wt < 0) continue;
-      // Mean incident edge length and the spring force toward it.
+      const double before = starWorst(n, x, &wt);
+      if (before < 0 || before >= options.quality_target || wt < 0) continue;
+      auto project = [&](Vec3 d) {
+        if (c.kind == Freedom::Plane) d -= d.dot(c.normal) * c.normal;
+        return d;
+      };
+      // Unit direction of the allowed part of d (zero when d is (nearly) all normal: the
+      // remainder would be rounding noise).
+      auto unitIn = [&](const Vec3& d) {
+        const Vec3 p = project(d);
+        const double len = p.norm();
+        return len > 1e-6 * d.norm() && len > 0 ? Vec3(project(p / len)) : Vec3::Zero();
+      };
       double sum = 0;
       int deg = 0;
-      for (int s = stars.offset[j]; s < stars.offset[j + 1]; ++s)
-        for (int k = 0; k < 4; ++k) {
-          const int m = mesh.T(stars.tets[s], k);
+      Vec3 force = Vec3::Zero();
+      for (int s = off[n]; s < off[n + 1]; ++s)
+        for (int k = 0; k < 4 && !(*dead)[star[s]]; ++k) {
+          const int m = mesh.T(star[s], k);
           if (m == n) continue;
           sum += (pos(m) - x).norm();
           ++deg;
@@ -75,16 +484,24 @@ void optimizeLocal3D(TetMesh& mesh, const LocalStars& stars, const Optimize3DOpt
       if (deg == 0) continue;
       const double h = sum / deg;
       scale = std::max(scale, h);
-      Vec3 force = Vec3::Zero();
-      for (int s = stars.offset[j]; s < stars.offset[j + 1]; ++s)
-        for (int k = 0; k < 4; ++k) {
-          const int m = mesh.T(stars.tets[s], k);
+      for (int s = off[n]; s < off[n + 1]; ++s)
+        for (int k = 0; k < 4 && !(*dead)[star[s]]; ++k) {
+          const int m = mesh.T(star[s], k);
           if (m == n) continue;
           const Vec3 d = pos(m) - x;
           const double len = d.norm();
           if (len > 0) force += (len - h) * d / len;
         }
-      // Push direction: away from the face opposite n in its worst tet.
+      // Gradient of the worst element's q* (central differences).
+      Vec3 grad = Vec3::Zero();
+      const double fd = 1e-4 * h;
+      for (int a = 0; a < 3; ++a) {
+        Vec3 e = Vec3::Zero();
+        e[a] = fd;
+        grad[a] = (tetQAt(wt, n, x + e) - tetQAt(wt, n, x - e)) / (2 * fd);
+      }
+      grad = unitIn(grad);
+      // Push: away from the face opposite n in its worst tet.
       Vec3 face[3];
       int f = 0;
       for (int k = 0; k < 4; ++k)
@@ -92,16 +509,19 @@ void optimizeLocal3D(TetMesh& mesh, const LocalStars& stars, const Optimize3DOpt
       Vec3 push = (face[1] - face[0]).cross(face[2] - face[0]);
       if (push.norm() > 0) push.normalize();
       if (push.dot(x - face[0]) < 0) push = -push;
-      const Vec3 dirs[2] = {options.step_gain * 2.0 * force / deg, 0.3 * h * push};
+      push = unitIn(push);
+      const Vec3 spring = options.step_gain * 2.0 * force / deg;
+      const Vec3 dirs[3] = {0.25 * h * grad, spring.norm() * unitIn(spring), 0.3 * h * push};
       double best = before;
       Vec3 bestX = x;
       for (const Vec3& d : dirs) {
+        if (d.squaredNorm() == 0) continue;
         double step = 1.0;
-        for (int tries = 0; tries < 4; ++tries, step *= 0.5) {
+        for (int tries = 0; tries < 5; ++tries, step *= 0.5) {
           const Vec3 y = x + step * d;
-          bool inverted = false;
-          const double q = worst(j, y, &inverted, nullptr);
-          if (!inverted && q > best) {
+          if (!sideKept(n, x, y)) continue;
+          const double q = starWorst(n, y, nullptr);
+          if (q > best) {
             best = q;
             bestX = y;
             break;
@@ -111,20 +531,22 @@ void optimizeLocal3D(TetMesh& mesh, const LocalStars& stars, const Optimize3DOpt
       if (best > before) {
         largest = std::max(largest, (bestX - x).norm());
         mesh.X.row(n) = bestX.transpose();
-        didMove[j] = 1;
-        if (best < options.quality_target) keep.push_back(j);
+        didMove[n] = 1;
+        movedNow.push_back(n);
       }
     }
-    work.swap(keep);
+    work.clear();
+    for (int n : movedNow) addBadAround(n, it + 1);
     if (largest <= options.stop_fraction * scale) {
       ++it;
       break;
     }
   }
-  if (iterations) *iterations = it;
+  if (counts) counts->iterations = it;
+  peel();
   if (moved)
-    for (int j = 0; j < count; ++j)
-      if (didMove[j]) moved->push_back(stars.nodes[j]);
+    for (int n = 0; n < N; ++n)
+      if (didMove[n]) moved->push_back(n);
 }
 
 }  // namespace hysim::cutting

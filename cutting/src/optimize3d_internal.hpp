@@ -1,6 +1,7 @@
 #pragma once
-// Shared between cut3d.cpp and optimize3d.cpp: the stars of the nodes the local optimisation
-// may move, built by the cut from what it touched (no whole-mesh adjacency).
+// Shared between cut3d.cpp and optimize3d.cpp: what the local optimisation after a cut needs
+// to know about the cut (which nodes lie on it, the surface for side checks) and where to
+// start (the nodes the cut touched).
 #include <cstdint>
 #include <vector>
 
@@ -8,13 +9,23 @@
 
 namespace hysim::cutting {
 
-struct LocalStars {
-  std::vector<std::int32_t> nodes;   // movable nodes (interior, off the cut)
-  std::vector<std::int32_t> offset;  // #nodes + 1, CSR into tets
-  std::vector<std::int32_t> tets;    // every tet around each node (new mesh indices)
+struct CutRegion {
+  const CutSurface* surface = nullptr;
+  double eps = 0;                       // on-surface tolerance (absolute)
+  std::vector<std::int32_t> seeds;      // nodes the cut created, moved or separated
+  std::vector<std::uint8_t> on_cut;     // #N of the output mesh: node lies on the cut
 };
 
-void optimizeLocal3D(TetMesh& mesh, const LocalStars& stars, const Optimize3DOptions& options,
-                     std::vector<std::int32_t>* moved, int* iterations);
+struct OptimizeCounts {
+  int iterations = 0;
+  int peeled = 0;
+  int collapsed = 0;
+  double peeled_volume = 0;
+};
+
+// See Optimize3DOptions. Appends the nodes it moved to *moved; *dead (#T) marks the slivers
+// it peeled (the caller removes them).
+void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DOptions& options,
+                       std::vector<std::int32_t>* moved, std::vector<std::uint8_t>* dead, OptimizeCounts* counts);
 
 }  // namespace hysim::cutting

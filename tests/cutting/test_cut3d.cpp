@@ -275,17 +275,21 @@ TEST(Cut3D, RandomizedPlanesAllMethods) {
       const Vec3 n(u(rng), u(rng), u(rng));
       for (CutMethod method : {CutMethod::Hybrid, CutMethod::Standard, CutMethod::Snap, CutMethod::Delete}) {
         SCOPED_TRACE(std::string(cutMethodName(method)) + " trial " + std::to_string(trial));
-        const auto r = cutAndCheck(mesh, p, n, withMethod(method), 1e-9);
+        // Hybrid peels slivers and collapses edges on the cut: volume within 0.1%.
+        const auto r = cutAndCheck(mesh, p, n, withMethod(method), method == CutMethod::Hybrid ? 1e-3 : 1e-9);
         if (method == CutMethod::Standard) {
           EXPECT_EQ(r.report.split_edges, r.report.crossed_edges);
         }
       }
-      // Hybrid with through-node routing and feature sliding: box corners are corners of flat
-      // facets and never slide, so the volume stays exact.
+      // Hybrid with through-node routing and feature sliding (box corners are corners of flat
+      // facets and never slide; the optimisation's peeling and collapses change the volume).
       SCOPED_TRACE("hybrid, routing + feature slide, trial " + std::to_string(trial));
       Cut3DOptions o;
       o.through_node_fraction = 0.1;
       o.feature_slide_fraction = 0.15;
+      cutAndCheck(mesh, p, n, o, 1e-3);
+      // Without the optimisation the hybrid cut keeps a flat-sided mesh's volume exactly.
+      o.optimize.enabled = false;
       cutAndCheck(mesh, p, n, o, 1e-9);
     }
   }
@@ -324,7 +328,7 @@ TEST(Cut3D, CurvedSurfaceFullCutSeparatesPiece) {
     const auto v = validate(r->mesh);
     EXPECT_TRUE(v.ok()) << v.error();
     if (method != CutMethod::Delete) {
-      EXPECT_NEAR(totalVolume(r->mesh), 1.0, 1e-6);
+      EXPECT_NEAR(totalVolume(r->mesh), 1.0, method == CutMethod::Hybrid ? 1e-3 : 1e-6);
       EXPECT_EQ(components(r->mesh), 2);
     }
     // No tet has nodes clearly inside and clearly outside the cylinder (within the strip).

@@ -1,7 +1,8 @@
-// Acceptance checks of issue 4 that the 3D cut meets today, over many random planes through
-// quality meshes (the uterus mesh, the Table 2 Gmsh ellipsoid). What does not hold yet
-// (q*_min >= 0.25x and min edge >= 0.2x the initial for every plane through the uterus mesh;
-// 20 successive cuts) is measured by `hysim tables --table 2` and reported, not asserted.
+// Acceptance checks of issue 4 over many random planes through quality meshes (the uterus
+// mesh, the Table 2 Gmsh ellipsoid). With exact plane cuts (the default) a few planes passing
+// within a few percent of an edge of a boundary corner node stay below q*_min >= 0.25x and
+// min edge >= 0.2x; with through-node routing every plane here meets both (asserted). The 20
+// successive cuts are measured by `hysim tables --table 2`.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -66,26 +67,26 @@ TEST(Cut3DAcceptance, UterusRandomPlanesValidGrowthVolume) {
   double q = 0, e = 0, dev = 0;
   int routed = 0;
   randomPlanes(*mesh, 40, {}, &q, &e, &routed, &dev);
-  // Reported, not yet asserted (acceptance wants >= 0.25 and >= 0.2 for every plane).
   RecordProperty("worst_q_ratio", std::to_string(q));
   RecordProperty("worst_edge_ratio", std::to_string(e));
   std::printf("uterus, 40 random planes: worst q*_min ratio %.3f, worst min edge ratio %.3f\n", q, e);
+  // Measured 0.243 / 0.120 on these planes; regression floors.
+  EXPECT_GE(q, 0.2);
+  EXPECT_GE(e, 0.1);
 }
 
-// With feature nodes allowed to slide a short way along their feature edges at corners and
-// bent ridges (moves the corner, so volume is kept to ~1e-4, not exactly; off by default).
-// Measured 0.065 / 0.079 on these planes; asserted with margin as a regression check.
-TEST(Cut3DAcceptance, UterusRandomPlanesFeatureSlide) {
+// Without feature sliding (corners and bent ridges stay where they are; on by default).
+TEST(Cut3DAcceptance, UterusRandomPlanesNoFeatureSlide) {
   const std::string path = std::string(HYSIM_SOURCE_DIR) + "/assets/uterus_myoma.msh";
   if (!std::filesystem::exists(path)) GTEST_SKIP() << "no " << path;
   auto mesh = readTetMesh(path);
   ASSERT_TRUE(mesh.ok()) << mesh.error();
   Cut3DOptions o;
-  o.feature_slide_fraction = 0.15;
+  o.feature_slide_fraction = 0.0;
   double q = 0, e = 0, dev = 0;
   int routed = 0;
   randomPlanes(*mesh, 40, o, &q, &e, &routed, &dev);
-  std::printf("uterus, 40 random planes, feature slide 0.15: worst q*_min ratio %.3f, worst min edge ratio %.3f\n", q, e);
+  std::printf("uterus, 40 random planes, no feature slide: worst q*_min ratio %.3f, worst min edge ratio %.3f\n", q, e);
   EXPECT_GE(q, 0.03);
   EXPECT_GE(e, 0.04);
 }
@@ -93,9 +94,8 @@ TEST(Cut3DAcceptance, UterusRandomPlanesFeatureSlide) {
 // Through-node routing as a last resort (crossings still within 0.1 |e| of a node after
 // snapping, the away move and ridge/feature sliding were refused) together with feature
 // sliding: elements around a routed node straddle the plane by at most its distance, checked
-// with that tolerance. Over 100 planes (seeds 7 / 11) this lifts the worst q*_min ratio from
-// 0.015 / 0.004 to 0.12 / 0.07 and the worst min edge ratio from 0.018 / 0.009 to 0.23 / 0.24
-// (routed nodes <= 0.41 / 0.36 mm off the plane); q*_min >= 0.25x still does not hold.
+// with that tolerance. Measured 0.753 / 0.470 on these planes (0.45 / 0.33 and 0.34 / 0.38
+// worst over 100 planes with seeds 7 / 11; routed nodes <= 0.41 mm off the plane).
 TEST(Cut3DAcceptance, UterusRandomPlanesRoutingAndFeatureSlide) {
   const std::string path = std::string(HYSIM_SOURCE_DIR) + "/assets/uterus_myoma.msh";
   if (!std::filesystem::exists(path)) GTEST_SKIP() << "no " << path;
@@ -110,8 +110,8 @@ TEST(Cut3DAcceptance, UterusRandomPlanesRoutingAndFeatureSlide) {
   std::printf("uterus, 40 random planes, routing 0.1 + feature slide 0.15: worst q*_min ratio %.3f, worst min edge "
               "ratio %.3f, %d routed nodes, max deviation %.3f mm\n",
               q, e, routed, dev);
-  EXPECT_GE(e, 0.2);  // the acceptance bound on the minimum edge holds
-  EXPECT_GE(q, 0.06); // regression floor; the acceptance bound 0.25 does not hold yet
+  EXPECT_GE(e, 0.2);   // the acceptance bounds
+  EXPECT_GE(q, 0.25);
 }
 
 TEST(Cut3DAcceptance, Table2EllipsoidHybridKeepsQuality) {

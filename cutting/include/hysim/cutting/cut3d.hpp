@@ -32,22 +32,36 @@
 
 namespace hysim::cutting {
 
-// Local optimisation after a hybrid cut (optimize3d.cpp): interior nodes up to `rings` edge
-// steps from the cut (not on the cut, not on the boundary) whose worst incident q* is below
-// quality_target try two moves, a damped spring step toward the local mean edge length and a
-// push of 0.3 * mean edge length away from the face opposite them in their worst tet (each
-// halved up to 3 times); a move is kept only if no incident tet inverts and the worst
-// incident q* rises, so the local minimum quality never drops. Sweeps stop when the largest
-// move is below stop_fraction * mean edge length, or after max_iterations. Stars come from
-// what the cut touched: no whole-mesh pass. Edge collapse on the cut is not done: the cut
-// avoids short edges instead (snapping, away moves, Cut3DOptions::through_node_fraction).
+// Local optimisation after a hybrid cut (optimize3d.cpp). Starting from the nodes the cut
+// created, moved or separated, every node of an element with q* below quality_target tries to
+// raise the worst q* around it: ascent along the gradient of its worst element's q*, a damped
+// spring step toward the local mean edge length, a push away from the face opposite it in its
+// worst element, each at decreasing lengths. A move is kept only if no incident tet inverts
+// and the worst incident q* rises, so the local minimum quality never drops. Interior nodes
+// move freely but never onto or across the cut; nodes on the cut slide within the cut plane
+// (move_cut_nodes; rim nodes, also on the outer boundary, stay); other boundary nodes slide
+// where their boundary is flat (move_boundary_nodes, boundary_flat_deg), perpendicular to
+// their area-weighted normal, which keeps the volume exactly. Nodes whose neighbours moved
+// are tried again; sweeps stop when the largest move is below stop_fraction * mean edge
+// length, or after max_iterations. Before and after the moves, slivers near the cut (q*
+// below peel_quality) with a boundary face are peeled off (removed) where the mesh stays
+// manifold: flat tets left where the cut meets the boundary at a shallow angle, which no move
+// can repair; their volume is tiny (Cut3DReport::peeled_volume). 0 disables peeling.
+// Local: one O(#T) node->tet pass, no whole-mesh sweep.
 struct Optimize3DOptions {
   bool enabled = true;
-  int rings = 1;
+  int rings = 2;  // nodes up to this many edge steps from what the cut touched may move
   double step_gain = 0.3;
   double stop_fraction = 0.02;
   int max_iterations = 8;
   double quality_target = 0.12;  // q* in [0, 1/3]; nodes with better neighbourhoods stay
+  bool move_cut_nodes = true;
+  bool move_boundary_nodes = true;
+  double boundary_flat_deg = 20.0;
+  double peel_quality = 0.03;
+  double collapse_fraction = 0.25;  // edges with an end on the cut shorter than this x their tet's mean edge
+  double collapse_volume_fraction = 0.1;  // a collapse changes its star's volume by at most this
+  double volume_budget = 5e-4;  // peeling + collapses change the mesh volume by at most this (relative)
 };
 
 struct Cut3DOptions {
@@ -68,11 +82,12 @@ struct Cut3DOptions {
   // touching a routed node may straddle the cut, by at most that node's distance; so
   // countStraddling / countFacesSharedAcross hold with eps = max_route_deviation_mm (and exactly,
   // eps ~ 0, when routed_nodes == 0). Volume is unaffected (routed nodes do not move).
-  // 0 (the default) disables it. Uterus mesh, 100 random planes, seeds 7 / 11: 0.1 lifts the
-  // worst q* ratio from 0.015 / 0.004 to 0.12 / 0.05 (0.12 / 0.07 with feature_slide_fraction
-  // 0.15, and the worst min edge ratio to 0.23 / 0.24), routed nodes <= 0.41 mm off the plane.
-  // Still short of 0.25: the remaining worst tets are flat tets with three nodes on the cut
-  // (a snapped node next to a split node) and one node 0.2-0.6 edge lengths off it.
+  // 0 (the default) disables it. Uterus mesh, 100 random planes each with seeds 7 / 11, with
+  // the optimisation (peeling, collapses, moves): the worst q*_min ratio is 0.09 / 0.24 without
+  // routing (3 + 1 of 200 planes below 0.25) and 0.45 / 0.34 with 0.1 (none below); the worst
+  // min edge ratio 0.07 / 0.10 without, 0.33 / 0.38 with; routed nodes <= 0.41 mm off the
+  // plane. What routing removes: cuts passing within a few percent of an edge of a corner
+  // node of the boundary (a Gmsh geometry point), which neither snaps nor slides.
   double through_node_fraction = 0.0;
   // Hybrid, plane cuts: a node that could not be snapped and whose crossed edge is still cut
   // within away_fraction * |e| of it moves AWAY from the plane (interior node: along the
@@ -84,12 +99,11 @@ struct Cut3DOptions {
   // Hybrid: a feature node may slide along one of its feature edges (onto the cut, or away
   // from it), which keeps it on the feature lines: along a straight ridge as far as a
   // boundary node may, at a corner or a bent ridge at most this fraction of the edge. That
-  // moves the corner, so the volume is no longer exact (~1e-4 on the uterus mesh); 0 (the
-  // default) keeps corners and bent ridges fixed. On the uterus mesh 0.15 lifts the worst q*
-  // over 100 random planes from ~0.004x to ~0.03x the initial minimum. Corners of flat facets
+  // moves the corner, so the volume is no longer exact (~1e-4 on the uterus mesh); 0 keeps
+  // corners and bent ridges fixed. Corners of flat facets
   // (every boundary face around the node coplanar with a neighbouring boundary face, as on a
   // box) never slide, so flat-sided meshes keep their volume exactly.
-  double feature_slide_fraction = 0.0;
+  double feature_slide_fraction = 0.15;
   double on_surface_tolerance = 1e-9;  // eps relative to the mesh bounding-box diagonal
   bool separate = true;             // duplicate the nodes on the cut
   Optimize3DOptions optimize;       // Hybrid only
@@ -112,6 +126,9 @@ struct Cut3DReport {
   int duplicated_nodes = 0;
   int cut_faces = 0;          // interior faces on the cut (now separated)
   int optimized_nodes = 0;
+  int collapsed_edges = 0;    // edges on the cut collapsed by the optimisation
+  int peeled_elements = 0;    // slivers removed by the optimisation
+  double peeled_volume = 0;   // their volume
   int optimize_iterations = 0;
   double cut_ms = 0, optimize_ms = 0;
 };
