@@ -295,16 +295,27 @@ void OuterWall::build(const cutting::TetMesh& mesh, const std::vector<std::uint8
       }
     }
   }
-  face_normal_.assign(static_cast<size_t>(F_.rows()), Eigen::Vector3d::Zero());
-  vertex_normal_.assign(static_cast<size_t>(V_.rows()), Eigen::Vector3d::Zero());
-  computeNormals();
+  vertex_face_start_.assign(static_cast<size_t>(V_.rows()) + 1, 0);
+  for (int f = 0; f < F_.rows(); ++f)
+    for (int c = 0; c < 3; ++c) ++vertex_face_start_[static_cast<size_t>(F_(f, c)) + 1];
+  for (size_t v = 0; v + 1 < vertex_face_start_.size(); ++v) vertex_face_start_[v + 1] += vertex_face_start_[v];
+  vertex_faces_.assign(static_cast<size_t>(3 * F_.rows()), -1);
+  {
+    std::vector<int> fill(vertex_face_start_.begin(), vertex_face_start_.end() - 1);
+    for (int f = 0; f < F_.rows(); ++f)
+      for (int c = 0; c < 3; ++c) vertex_faces_[static_cast<size_t>(fill[static_cast<size_t>(F_(f, c))]++)] = f;
+  }
   bvh_.build(V_, F_);
 
-  // Grid: a cell needs no query when its centre is more than band + half its diagonal
-  // inside (the signed distance changes by at most the distance moved).
+  // Grid: a cell needs no query when its centre is more than band + slack + half its
+  // diagonal inside (the signed distance changes by at most the distance the point or the
+  // surface moves).
   needs_query_.clear();
   grid_size_.setZero();
-  if (!static_ || F_.rows() == 0) return;
+  grid_valid_ = false;
+  if (F_.rows() == 0) return;
+  grid_slack_ = static_ ? 0.0 : cell_;
+  grid_V_ = V_;
   const Eigen::Vector3d lo = V_.colwise().minCoeff().transpose();
   const Eigen::Vector3d hi = V_.colwise().maxCoeff().transpose();
   grid_origin_ = lo - Eigen::Vector3d::Constant(cell_);
@@ -315,37 +326,44 @@ void OuterWall::build(const cutting::TetMesh& mesh, const std::vector<std::uint8
     for (int j = 0; j < grid_size_[1]; ++j) {
       for (int k = 0; k < grid_size_[2]; ++k) {
         const Eigen::Vector3d centre = grid_origin_ + cell_ * Eigen::Vector3d(i + 0.5, j + 0.5, k + 0.5);
-        const bool far = signedDistance(centre) - half_diagonal >= band_;
+        const bool far = signedDistance(centre) - half_diagonal >= band_ + grid_slack_;
         needs_query_[static_cast<size_t>((i * grid_size_[1] + j) * grid_size_[2] + k)] = far ? 0 : 1;
       }
     }
   }
+  grid_valid_ = true;
 }
 
-void OuterWall::computeNormals() {
-  for (auto& n : vertex_normal_) n.setZero();
-  for (int f = 0; f < F_.rows(); ++f) {
-    const Eigen::Vector3d p[3] = {row(V_, F_(f, 0)), row(V_, F_(f, 1)), row(V_, F_(f, 2))};
-    Eigen::Vector3d n = (p[1] - p[0]).cross(p[2] - p[0]);
-    const double len = n.norm();
-    n = len > 0.0 ? Eigen::Vector3d(n / len) : Eigen::Vector3d::Zero();
-    face_normal_[static_cast<size_t>(f)] = n;
-    for (int c = 0; c < 3; ++c) {
-      const Eigen::Vector3d e1 = p[(c + 1) % 3] - p[c], e2 = p[(c + 2) % 3] - p[c];
-      const double denom = e1.norm() * e2.norm();
-      const double angle = denom > 0.0 ? std::acos(std::clamp(e1.dot(e2) / denom, -1.0, 1.0)) : 0.0;
-      vertex_normal_[static_cast<size_t>(F_(f, c))] += angle * n;
-    }
+Eigen::Vector3d OuterWall::faceNormal(int f) const {
+  const Eigen::Vector3d a = row(V_, F_(f, 0));
+  const Eigen::Vector3d n = (row(V_, F_(f, 1)) - a).cross(row(V_, F_(f, 2)) - a);
+  const double len = n.norm();
+  return len > 0.0 ? Eigen::Vector3d(n / len) : Eigen::Vector3d::Zero();
+}
+
+Eigen::Vector3d OuterWall::vertexNormal(int v) const {
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  for (int k = vertex_face_start_[static_cast<size_t>(v)]; k < vertex_face_start_[static_cast<size_t>(v) + 1]; ++k) {
+    const int f = vertex_faces_[static_cast<size_t>(k)];
+    int c = 0;
+    while (c < 2 && F_(f, c) != v) ++c;
+    const Eigen::Vector3d p = row(V_, v);
+    const Eigen::Vector3d e1 = row(V_, F_(f, (c + 1) % 3)) - p, e2 = row(V_, F_(f, (c + 2) % 3)) - p;
+    const double angle = std::atan2(e1.cross(e2).norm(), e1.dot(e2));
+    sum += angle * faceNormal(f);
   }
+  return sum;
 }
 
 void OuterWall::update(const sim::NodeVectors& x) {
   if (static_ || F_.rows() == 0) return;
+  double moved2 = 0.0;
   for (Eigen::Index s = 0; s < V_.rows(); ++s) {
     const int node = node_[static_cast<size_t>(s)];
     if (node >= 0 && node < x.rows()) V_.row(s) = x.row(node);
+    moved2 = std::max(moved2, (V_.row(s) - grid_V_.row(s)).squaredNorm());
   }
-  computeNormals();
+  grid_valid_ = !needs_query_.empty() && moved2 <= grid_slack_ * grid_slack_;
   bvh_.refit(V_);
 }
 
@@ -364,19 +382,19 @@ double OuterWall::signedDistance(const Eigen::Vector3d& p) const {
   // exact for a closed surface, and right near an open one's interior.
   Eigen::Vector3d n;
   if (feature == 0) {
-    n = face_normal_[static_cast<size_t>(f)];
+    n = faceNormal(f);
   } else if (feature <= 3) {
-    n = vertex_normal_[static_cast<size_t>(F_(f, feature - 1))];
+    n = vertexNormal(F_(f, feature - 1));
   } else {
     const int other = neighbour_[static_cast<size_t>(3 * f + feature - 4)];
-    n = face_normal_[static_cast<size_t>(f)] + face_normal_[static_cast<size_t>(other >= 0 ? other : f)];
+    n = faceNormal(f) + faceNormal(other >= 0 ? other : f);
   }
   const double d = (p - closest).norm();
   return (p - closest).dot(n) > 0.0 ? -d : d;
 }
 
 bool OuterWall::farInside(const Eigen::Vector3d& p) const {
-  if (needs_query_.empty()) return false;
+  if (!grid_valid_) return false;
   const Eigen::Vector3d g = (p - grid_origin_) / cell_;
   int idx[3];
   for (int k = 0; k < 3; ++k) {

@@ -122,6 +122,15 @@ TEST(OuterWall, MovingSurfaceFollowsTheNodes) {
   }
   wall.update(x);
   EXPECT_NEAR(wall.signedDistance({4, 3, 5.0}), 1.0, 1e-12);
+  // The grid (made for the rest shape) stays right for the moved surface: it keeps a slack.
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(-2, 10);
+  for (int i = 0; i < 2000; ++i) {
+    const Eigen::Vector3d p(u(rng), u(rng), u(rng));
+    const double sd = wall.signedDistance(p);
+    if (sd < 1.0) EXPECT_DOUBLE_EQ(wall.clearance(p), sd) << p.transpose();
+    else EXPECT_GE(wall.clearance(p), 1.0) << p.transpose();
+  }
 }
 
 // The scene minus the keyframes before `from`, shifted to start at t = 0.

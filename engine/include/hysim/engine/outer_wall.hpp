@@ -54,9 +54,10 @@ class TriangleBvh {
 class OuterWall {
  public:
   // Finds the serosal faces of `mesh` (the initial mesh). `fixed` (#N, 1 = anchored): when
-  // every serosal node is anchored the surface never moves, and a grid of cells of
-  // `cell_mm` marks where a point is surely farther than `band_mm` inside the wall, so most
-  // queries cost one look-up. Otherwise update() moves the surface with the tissue.
+  // every serosal node is anchored the surface never moves; otherwise update() moves it
+  // with the tissue. A grid of cells of `cell_mm` marks where a point is surely farther
+  // than `band_mm` inside the wall (for a moving surface: farther than band_mm + cell_mm, and
+  // only while no vertex has moved more than cell_mm), so most queries cost one look-up.
   void build(const cutting::TetMesh& mesh, const std::vector<std::uint8_t>& fixed, double band_mm,
              double cell_mm = 2.0);
   bool empty() const { return F_.rows() == 0; }
@@ -79,23 +80,27 @@ class OuterWall {
   double clearance(const Eigen::Vector3d& p) const;
 
  private:
-  void computeNormals();
+  Eigen::Vector3d faceNormal(int f) const;    // unit, outward
+  Eigen::Vector3d vertexNormal(int v) const;  // angle-weighted sum of the face normals
   bool farInside(const Eigen::Vector3d& p) const;
 
   cutting::Positions V_;             // #S x 3 serosal vertices
   cutting::Tris F_;                  // #F x 3 serosal faces (outward), into V_
   std::vector<int> node_;            // #S mesh node of each vertex (-1: gone)
   std::vector<int> neighbour_;       // #F*3: face across edge k of face f (-1: none)
-  std::vector<Eigen::Vector3d> face_normal_, vertex_normal_;  // #F, #S (angle-weighted)
+  std::vector<int> vertex_face_start_, vertex_faces_;  // #S+1, #F*3: faces around each vertex
   TriangleBvh bvh_;
   bool static_ = false;
   double band_ = 0.0;
   int num_boundary_faces_ = 0;
-  // Grid over the surface's bounding box (static surfaces only): 1 = a query is needed.
+  // Grid over the surface's bounding box: 1 = a query is needed.
   Eigen::Vector3d grid_origin_{0, 0, 0};
   double cell_ = 1.0;
   Eigen::Vector3i grid_size_{0, 0, 0};
   std::vector<std::uint8_t> needs_query_;
+  cutting::Positions grid_V_;  // #S x 3 vertex positions the grid was made for
+  double grid_slack_ = 0.0;    // how far vertices may move before the grid is void
+  bool grid_valid_ = false;
 };
 
 }  // namespace hysim::engine
