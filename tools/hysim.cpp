@@ -98,14 +98,8 @@ int runCommand(const RunArgs& args) {
                 "state_hash %s; warnings %d\n",
                 report->steps, report->wall_s, report->step_us_median, report->step_us_p99, report->frames,
                 report->frame_ms_median, engine::hashHex(report->state_hash).c_str(), report->warnings);
-    if (!report->passes.empty()) {
-      double myoma = 0.0;
-      for (const auto& p : report->passes) myoma += p.removed_myoma_mm3;
-      std::printf("%zu shaving passes: myoma resected %.0f mm3 (%.1f%% of %.0f mm3), last q*_min %.4f\n",
-                  report->passes.size(), myoma,
-                  report->initial_myoma_mm3 > 0 ? 100.0 * myoma / report->initial_myoma_mm3 : 0.0,
-                  report->initial_myoma_mm3, report->passes.back().q_min);
-    }
+    if (!report->passes.empty()) std::printf("last pass: q*_min %.4f\n", report->passes.back().q_min);
+    std::printf("%s", engine::summaryText(*report).c_str());
     if (!args.frames.empty()) std::printf("frames in %s\n", args.frames.c_str());
     if (!args.report.empty()) std::printf("report in %s\n", args.report.c_str());
   }

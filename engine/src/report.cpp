@@ -76,7 +76,46 @@ Result<RunReport> run(Simulation& sim, const RunOptions& options) {
   r.initial_myoma_mm3 = sim.initialMyomaVolume();
   r.electrode_active_s = sim.electrodeActiveSeconds();
   r.path_length_mm = sim.pathLengthMm();
+  r.perforation_margin_mm = scene.safety.perforation_margin_mm;
+  r.perforations = sim.perforations();
+  r.perforation_events = sim.perforationEvents();
+  r.serosa_faces = sim.outerWall().numFaces();
   return r;
+}
+
+RunSummary summarize(const RunReport& r) {
+  RunSummary s;
+  double removed = 0.0;
+  std::vector<double> cut_ms;
+  for (const PassRecord& p : r.passes) {
+    s.myoma_resected_mm3 += p.removed_myoma_mm3;
+    removed += p.removed_mm3;
+    cut_ms.push_back(p.cut_ms);
+  }
+  s.myoma_resected_pct = r.initial_myoma_mm3 > 0.0 ? 100.0 * s.myoma_resected_mm3 / r.initial_myoma_mm3 : 0.0;
+  s.healthy_removed_mm3 = removed - s.myoma_resected_mm3;
+  s.perforations = r.perforations;
+  s.passes = static_cast<int>(r.passes.size());
+  s.electrode_active_s = r.electrode_active_s;
+  s.path_length_mm = r.path_length_mm;
+  s.cut_ms_median = percentile(cut_ms, 0.5);
+  s.cut_ms_max = cut_ms.empty() ? 0.0 : *std::max_element(cut_ms.begin(), cut_ms.end());
+  return s;
+}
+
+std::string summaryText(const RunReport& r) {
+  const RunSummary s = summarize(r);
+  char buf[1024];
+  std::snprintf(buf, sizeof(buf),
+                "myoma resected    %.0f mm3 (%.1f%% of %.0f mm3)\n"
+                "healthy removed   %.0f mm3\n"
+                "perforations      %d (margin %.1f mm to the serosa)\n"
+                "passes            %d (cut ms median %.1f, max %.1f)\n"
+                "electrode active  %.2f s\n"
+                "path length       %.0f mm\n",
+                s.myoma_resected_mm3, s.myoma_resected_pct, r.initial_myoma_mm3, s.healthy_removed_mm3, s.perforations,
+                r.perforation_margin_mm, s.passes, s.cut_ms_median, s.cut_ms_max, s.electrode_active_s, s.path_length_mm);
+  return buf;
 }
 
 std::string reportJson(const RunReport& r) {
@@ -99,10 +138,8 @@ std::string reportJson(const RunReport& r) {
   j["warnings"] = r.warnings;
   j["max_tool_force_n"] = r.max_tool_force_n;
   j["wall_s"] = r.wall_s;
-  std::vector<double> cut_ms;
   nlohmann::ordered_json per_pass = nlohmann::ordered_json::array();
   for (const PassRecord& p : r.passes) {
-    cut_ms.push_back(p.cut_ms);
     nlohmann::ordered_json e;
     e["time_s"] = p.time_s;
     e["elements"] = p.elements;
@@ -124,18 +161,22 @@ std::string reportJson(const RunReport& r) {
     if (p.cut_failed) e["failed"] = p.message;
     per_pass.push_back(e);
   }
-  double myoma_removed = 0.0, removed = 0.0;
-  for (const PassRecord& p : r.passes) {
-    myoma_removed += p.removed_myoma_mm3;
-    removed += p.removed_mm3;
-  }
-  j["myoma_resected_mm3"] = myoma_removed;
-  j["myoma_resected_pct"] = r.initial_myoma_mm3 > 0.0 ? 100.0 * myoma_removed / r.initial_myoma_mm3 : 0.0;
-  j["healthy_removed_mm3"] = removed - myoma_removed;
+  const RunSummary sum = summarize(r);
+  j["myoma_resected_mm3"] = sum.myoma_resected_mm3;
+  j["myoma_resected_pct"] = sum.myoma_resected_pct;
+  j["healthy_removed_mm3"] = sum.healthy_removed_mm3;
   j["electrode_active_s"] = r.electrode_active_s;
   j["path_length_mm"] = r.path_length_mm;
   j["passes"] = r.passes.size();
-  j["cut_ms"] = {{"median", percentile(cut_ms, 0.5)}, {"max", cut_ms.empty() ? 0.0 : *std::max_element(cut_ms.begin(), cut_ms.end())}};
+  j["cut_ms"] = {{"median", sum.cut_ms_median}, {"max", sum.cut_ms_max}};
+  j["perforation_margin_mm"] = r.perforation_margin_mm;
+  j["serosa_faces"] = r.serosa_faces;
+  j["perforations"] = r.perforations;
+  nlohmann::ordered_json events = nlohmann::ordered_json::array();
+  for (const PerforationEvent& e : r.perforation_events) {
+    events.push_back({{"time_s", e.time_s}, {"end_s", e.end_s}, {"min_distance_mm", e.min_distance_mm}});
+  }
+  j["perforation_events"] = events;
   j["per_pass"] = per_pass;
   return j.dump(2) + "\n";
 }

@@ -215,7 +215,7 @@ Scene parse(const Reader& r, const YAML::Node& root, const std::string& path) {
   scene.path = path;
   if (!root.IsDefined() || root.IsNull()) r.fail(root, "the scene file is empty");
   r.checkKeys(root, "scene", {"name", "description", "mesh", "tool_mesh", "materials", "anchors", "simulation",
-                              "contact", "tool_path", "camera", "render"});
+                              "contact", "safety", "tool_path", "camera", "render"});
   const fs::path dir = fs::path(path).parent_path();
   auto resolve = [&](const YAML::Node& n, const std::string& key) {
     const std::string rel = r.string(n, key);
@@ -245,6 +245,16 @@ Scene parse(const Reader& r, const YAML::Node& root, const std::string& path) {
   }
   if (root["simulation"]) parseSimulation(r, root["simulation"], scene);
   if (root["contact"]) parseContact(r, root["contact"], scene.contact);
+  if (root["safety"]) {
+    const YAML::Node s = root["safety"];
+    r.checkKeys(s, "safety", {"perforation_margin_mm"});
+    if (s["perforation_margin_mm"]) {
+      scene.safety.perforation_margin_mm = r.nonNegative(s["perforation_margin_mm"], "perforation_margin_mm");
+      if (scene.safety.perforation_margin_mm > 50.0) {
+        r.fail(s["perforation_margin_mm"], "'perforation_margin_mm' must be at most 50, got " + s["perforation_margin_mm"].Scalar());
+      }
+    }
+  }
 
   const YAML::Node tp = r.require(root, "tool_path", "scene");
   if (!tp.IsSequence() || tp.size() == 0) r.fail(tp, "'tool_path' must be a non-empty list of keyframes");

@@ -7,6 +7,7 @@
 #include <assimp/Importer.hpp>
 #include <chrono>
 #include <cmath>
+#include <limits>
 
 #include "hysim/cutting/cut3d.hpp"
 #include "hysim/cutting/mesh_io.hpp"
@@ -147,6 +148,10 @@ Result<std::unique_ptr<Simulation>> Simulation::create(const Scene& scene) {
   s->previous_wire_ = s->wire_;
   s->sweep_.reserve(10000, static_cast<int>(s->wire_.rows()));  // a 10 s pass without allocating
   if (Status st = s->setTopology(s->mesh_, nullptr, nullptr); !st.ok()) return Error{scene.path + ": " + st.error()};
+  // The serosa of the initial mesh; exact distances are needed up to margin + wire radius.
+  s->outer_wall_.build(s->mesh_, s->model_.fixed, scene.safety.perforation_margin_mm + s->loop_.wire_radius_mm);
+  s->perforation_events_.reserve(kMaxPerforationEvents);
+  s->serosa_clearance_mm_ = std::numeric_limits<double>::infinity();
   for (const sim::Material& m : scene.materials) {
     if (m.name != "myoma") continue;
     for (int t = 0; t < s->mesh_.numTets(); ++t) {
@@ -217,6 +222,11 @@ void Simulation::step() {
   // it stays there; on exit (or pedal release) the sweep is cut.
   previous_wire_ = wire_;
   loopPoints(loop_, pose_, wire_);
+  if (pose_.pedal) {
+    checkPerforation();
+  } else {
+    perforating_ = false;  // an inactive loop cannot perforate: the event ends
+  }
   if (!pose_.pedal && !cutting_) {
     loop_in_tissue_ = false;
     return;
@@ -232,6 +242,33 @@ void Simulation::step() {
   } else if (cutting_) {
     sweep_.advance(wire_);
     finishPass();
+  }
+}
+
+void Simulation::checkPerforation() {
+  outer_wall_.update(state_.x);  // a serosa with free nodes moves with the tissue
+  double clearance = std::numeric_limits<double>::infinity();
+  for (Eigen::Index i = 0; i < wire_.rows(); ++i) {
+    clearance = std::min(clearance, outer_wall_.clearance(wire_.row(i).transpose()) - loop_.wire_radius_mm);
+  }
+  serosa_clearance_mm_ = clearance;
+  if (!(clearance < scene_.safety.perforation_margin_mm)) {
+    perforating_ = false;
+    return;
+  }
+  if (!perforating_) {
+    perforating_ = true;
+    ++perforation_count_;
+    // Within the reserved capacity only: the step never allocates.
+    if (perforation_events_.size() < perforation_events_.capacity()) {
+      perforation_events_.push_back({state_.time, state_.time, clearance});
+    }
+    return;
+  }
+  if (!perforation_events_.empty() && static_cast<int>(perforation_events_.size()) == perforation_count_) {
+    PerforationEvent& e = perforation_events_.back();
+    e.end_s = state_.time;
+    e.min_distance_mm = std::min(e.min_distance_mm, clearance);
   }
 }
 
@@ -363,6 +400,13 @@ void Simulation::finishPass() {
   for (int i = 0; i < n; ++i) {
     if (new_index[i] >= 0) on_cut_[new_index[i]] = on_cut[i];
   }
+  // The serosa follows its nodes into the new numbering.
+  std::vector<int> old_to_kept(change.node_old_to_new.size(), -1);
+  for (size_t i = 0; i < change.node_old_to_new.size(); ++i) {
+    const int j = change.node_old_to_new[i];
+    if (j >= 0 && j < n) old_to_kept[i] = new_index[j];
+  }
+  outer_wall_.remapNodes(old_to_kept);
   if (Status st = setTopology(std::move(rest_mesh), &x_kept, &v_kept); !st.ok()) return fail(st.error());
   const cutting::MeshStats stats = cutting::computeStats(mesh_);
   rec.elements = mesh_.numTets();

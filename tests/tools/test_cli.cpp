@@ -102,6 +102,27 @@ TEST(Cli, RunWritesFramesAndReport) {
   EXPECT_EQ(j["state_hash"].get<std::string>().size(), 16u);
 }
 
+TEST(Cli, RunPrintsTheMetricsSummaryUnlessQuiet) {
+  const std::string dir = outDir("summary");
+  const Output o = hysim("run --steps 20 --report " + dir + "/report.json");
+  ASSERT_EQ(o.exit_code, 0) << o.text;
+  for (const char* line : {"myoma resected    0 mm3 (0.0% of 2057 mm3)", "healthy removed   0 mm3",
+                           "perforations      0 (margin 2.0 mm to the serosa)", "passes            0 (cut ms median",
+                           "electrode active  0.00 s", "path length"}) {
+    EXPECT_NE(o.text.find(line), std::string::npos) << line << " missing in\n" << o.text;
+  }
+  std::ifstream in(dir + "/report.json");
+  const auto j = nlohmann::json::parse(in);
+  EXPECT_EQ(j["perforations"].get<int>(), 0);
+  EXPECT_TRUE(j["perforation_events"].is_array());
+  EXPECT_DOUBLE_EQ(j["perforation_margin_mm"].get<double>(), 2.0);
+  EXPECT_TRUE(j["cut_ms"].contains("median"));
+  EXPECT_TRUE(j["cut_ms"].contains("max"));
+  const Output quiet = hysim("run --steps 20 --quiet");
+  ASSERT_EQ(quiet.exit_code, 0) << quiet.text;
+  EXPECT_EQ(quiet.text, "");
+}
+
 TEST(Cli, BadSceneFailsAndKeepsTheOldReport) {
   const std::string dir = outDir("bad");
   std::ofstream(dir + "/report.json") << "{\"kept\": true}\n";

@@ -15,8 +15,11 @@ cav_a = 16; cav_b = 11; cav_c = 24;    // distended cavity, ellipsoid semi-axes 
 out_a = 28; out_b = 23; out_c = 36;    // outer uterine surface, ellipsoid semi-axes
 canal_r = 3.5;                          // cervical canal radius
 canal_z0 = -40; canal_z1 = -20;         // canal runs along z from z0 to z1 (through the wall)
-myo_x = 0; myo_y = -9; myo_z = 4;       // myoma centre (posterior wall, ~6 mm embedded)
-myo_r = 8;                              // myoma radius
+// Myoma centre and radius. The defaults give the FIGO type 1 myoma of assets/uterus_myoma.msh;
+// `gmsh -setnumber myo_y V -setnumber myo_r V` overrides them (tools/make-uterus-mesh --figo 2).
+myo_x = 0; myo_z = 4;
+DefineConstant[ myo_y = -9 ];           // posterior wall, ~6 mm of the type 1 myoma embedded
+DefineConstant[ myo_r = 8 ];
 
 // The simulator's explicit substep is set by the highest natural frequency of the
 // mass-spring network, ~ sqrt(E / rho) / (local edge length). The myoma is 2.5x stiffer

@@ -36,7 +36,26 @@ struct RunReport {
   double initial_myoma_mm3 = 0.0;
   double electrode_active_s = 0.0;
   double path_length_mm = 0.0;
+  double perforation_margin_mm = 0.0;
+  int perforations = 0;                            // events (see PerforationEvent)
+  std::vector<PerforationEvent> perforation_events;  // the first Simulation::kMaxPerforationEvents
+  int serosa_faces = 0;                            // outer-surface faces the check measures against
 };
+
+// Numbers a trainee or instructor reads after a run (also in the JSON report).
+struct RunSummary {
+  double myoma_resected_mm3 = 0.0;
+  double myoma_resected_pct = 0.0;  // of the initial myoma volume
+  double healthy_removed_mm3 = 0.0;
+  int perforations = 0;
+  int passes = 0;
+  double electrode_active_s = 0.0;
+  double path_length_mm = 0.0;
+  double cut_ms_median = 0.0, cut_ms_max = 0.0;
+};
+RunSummary summarize(const RunReport& report);
+// A few lines of text with the summary's numbers.
+std::string summaryText(const RunReport& report);
 
 Result<RunReport> run(Simulation& simulation, const RunOptions& options);
 

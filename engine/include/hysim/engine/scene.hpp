@@ -31,6 +31,13 @@ struct ContactSettings {
   double loop_drop_mm = 3.0;         // loop centre below the axis (towards -up)
 };
 
+// Safety checks that become events in the report (and warnings for the trainee).
+struct SafetySettings {
+  // A perforation event: the active loop's wire comes closer than this to the outer
+  // (serosal) surface of the uterus, or beyond it.
+  double perforation_margin_mm = 2.0;
+};
+
 struct CameraSettings {
   double lens_deg = 30.0;  // fore-oblique lens angle: 0, 12 or 30 in practice
   double fov_deg = 90.0;
@@ -55,6 +62,7 @@ struct Scene {
   int steps = 1000;
   std::vector<haptics::Keyframe> tool_path;
   ContactSettings contact;
+  SafetySettings safety;
   CameraSettings camera;
   RenderSettings render;
 };

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "hysim/cutting/mesh.hpp"
+#include "hysim/engine/outer_wall.hpp"
 #include "hysim/engine/scene.hpp"
 #include "hysim/engine/tet_locator.hpp"
 #include "hysim/engine/tool.hpp"
@@ -34,6 +35,14 @@ struct PassRecord {
   double added_mass_g = 0.0; // mass scaling needed to keep substeps within the cap
   bool cut_failed = false;   // the cut was refused (the mesh is left as it was)
   std::string message;
+};
+
+// One perforation event: while the electrode was active, the loop's wire came closer than
+// the scene's safety.perforation_margin_mm to the outer (serosal) surface, or went beyond it.
+struct PerforationEvent {
+  double time_s = 0.0;           // first step of the event
+  double end_s = 0.0;            // last step of the event (still open: the latest step)
+  double min_distance_mm = 0.0;  // closest approach of the wire's surface; < 0: beyond the serosa
 };
 
 class Simulation {
@@ -72,6 +81,16 @@ class Simulation {
   double initialMyomaVolume() const { return initial_myoma_mm3_; }  // mm^3, rest shape
   double electrodeActiveSeconds() const { return electrode_active_s_; }
   double pathLengthMm() const { return path_length_mm_; }         // of the scope tip
+  // Perforation check (runs while the pedal is down). perforations() counts events; the
+  // list keeps the first kMaxPerforationEvents of them.
+  static constexpr int kMaxPerforationEvents = 1000;
+  int perforations() const { return perforation_count_; }
+  const std::vector<PerforationEvent>& perforationEvents() const { return perforation_events_; }
+  bool perforating() const { return perforating_; }  // an event is open now
+  // Distance of the wire's surface from the serosa at the last active step, mm: exact below
+  // the margin, otherwise some value >= the margin (+inf before the first active step).
+  double serosaClearanceMm() const { return serosa_clearance_mm_; }
+  const OuterWall& outerWall() const { return outer_wall_; }
   // Puts back a state saved from this simulation (benchmarks restore one before each batch).
   // Same topology only; copies into the existing buffers.
   void restoreState(const sim::State& saved) { state_ = saved; }
@@ -84,6 +103,7 @@ class Simulation {
   Status setTopology(cutting::TetMesh rest_mesh, const sim::NodeVectors* x, const sim::NodeVectors* v);
   bool wireInTissue();
   void finishPass();
+  void checkPerforation();
 
   Scene scene_;
   cutting::TetMesh mesh_;
@@ -116,6 +136,13 @@ class Simulation {
   double initial_myoma_mm3_ = 0.0;
   double electrode_active_s_ = 0.0;
   double path_length_mm_ = 0.0;
+
+  // Perforation.
+  OuterWall outer_wall_;  // serosa of the initial mesh
+  std::vector<PerforationEvent> perforation_events_;  // capacity reserved at create()
+  int perforation_count_ = 0;
+  bool perforating_ = false;
+  double serosa_clearance_mm_ = 0.0;
 };
 
 // Loads a surface (OBJ, STL, PLY, glTF...) with assimp, triangulated, in millimetres.
