@@ -1,8 +1,9 @@
 #include "hysim/engine/collision.hpp"
 
+#include <fcl/math/bv/utility.h>  // fit(), which BVH_model-inl.h uses without including
 #include <fcl/geometry/bvh/BVH_model.h>
-#include <fcl/geometry/shape/capsule.h>
-#include <fcl/narrowphase/collision.h>
+#include <fcl/narrowphase/detail/traversal/collision_node.h>
+#include <fcl/narrowphase/detail/traversal/distance/mesh_distance_traversal_node.h>
 
 #include <algorithm>
 #include <array>
@@ -10,10 +11,73 @@
 
 namespace hysim::engine {
 
+using Bvh = fcl::BVHModel<fcl::AABBd>;
+
+// ---------------------------------------------------------------------------------------
+struct SweptWire::Impl {
+  std::shared_ptr<Bvh> bvh;
+  int points = 0;
+};
+
+SweptWire::SweptWire() : impl_(std::make_unique<Impl>()) {}
+SweptWire::~SweptWire() = default;
+SweptWire::SweptWire(SweptWire&&) noexcept = default;
+SweptWire& SweptWire::operator=(SweptWire&&) noexcept = default;
+
+int SweptWire::numPoints() const { return impl_->points; }
+int SweptWire::numTriangles() const { return impl_->points > 1 ? 2 * (impl_->points - 1) : 0; }
+
+void SweptWire::reset(int points) {
+  impl_->points = std::max(points, 0);
+  impl_->bvh.reset();
+  if (points < 2) return;
+  // Vertices: row 0 = previous wire (0..P-1), row 1 = current wire (P..2P-1).
+  std::vector<fcl::Vector3d> vertices(static_cast<size_t>(2 * points), fcl::Vector3d::Zero());
+  // Spread the initial vertices so the first build sees a proper strip (refits keep the tree).
+  for (int i = 0; i < points; ++i) {
+    vertices[static_cast<size_t>(i)] = fcl::Vector3d(i, 0, 0);
+    vertices[static_cast<size_t>(points + i)] = fcl::Vector3d(i, 1, 0);
+  }
+  std::vector<fcl::Triangle> triangles;
+  triangles.reserve(static_cast<size_t>(2 * (points - 1)));
+  for (int i = 0; i + 1 < points; ++i) {
+    const int a = i, b = i + 1, c = points + i, d = points + i + 1;  // a-b previous, c-d current
+    triangles.emplace_back(a, b, d);
+    triangles.emplace_back(a, d, c);
+  }
+  impl_->bvh = std::make_shared<Bvh>();
+  impl_->bvh->beginModel(static_cast<int>(triangles.size()), static_cast<int>(vertices.size()));
+  impl_->bvh->addSubModel(vertices, triangles);
+  impl_->bvh->endModel();
+}
+
+void SweptWire::update(const WirePoints& previous, const WirePoints& current) {
+  Bvh* bvh = impl_->bvh.get();
+  const int n = impl_->points;
+  if (bvh == nullptr || previous.rows() != n || current.rows() != n) return;
+  bvh->beginReplaceModel();
+  for (int i = 0; i < n; ++i) bvh->replaceVertex(previous.row(i).transpose());
+  for (int i = 0; i < n; ++i) bvh->replaceVertex(current.row(i).transpose());
+  bvh->endReplaceModel(true, true);  // refit bottom-up, keep the tree
+}
+
+void SweptWire::triangle(int t, Eigen::Vector3d& a, Eigen::Vector3d& b, Eigen::Vector3d& c) const {
+  const Bvh& bvh = *impl_->bvh;
+  const fcl::Triangle& tri = bvh.tri_indices[t];
+  a = bvh.vertices[tri[0]];
+  b = bvh.vertices[tri[1]];
+  c = bvh.vertices[tri[2]];
+}
+
+// ---------------------------------------------------------------------------------------
 struct TissueCollision::Impl {
-  std::shared_ptr<fcl::BVHModel<fcl::AABBd>> bvh;
-  std::vector<fcl::Vector3d> vertices;  // #N, reused by every refit
+  std::shared_ptr<Bvh> bvh;
+  std::vector<int> nodes;  // #V node ids of the hierarchy's vertices
   int num_faces = 0;
+  bool children_after_parents = false;  // FCL's build order, checked once per build
+  double margin = 0.0;                  // mm, leaf boxes are grown by this
+  std::vector<fcl::Vector3d> refit_x;   // #V vertex positions at the last refit
+  long refits = 0;
 };
 
 TissueCollision::TissueCollision() : impl_(std::make_unique<Impl>()) {}
@@ -22,9 +86,11 @@ TissueCollision::TissueCollision(TissueCollision&&) noexcept = default;
 TissueCollision& TissueCollision::operator=(TissueCollision&&) noexcept = default;
 
 int TissueCollision::numFaces() const { return impl_->num_faces; }
+int TissueCollision::numVertices() const { return static_cast<int>(impl_->nodes.size()); }
+double TissueCollision::margin() const { return impl_->margin; }
+long TissueCollision::numRefits() const { return impl_->refits; }
 
-Status TissueCollision::build(const cutting::TetMesh& mesh, const sim::NodeVectors& x) {
-  // Unique faces (sorted node triples) of all tets.
+cutting::Tris allTetFaces(const cutting::TetMesh& mesh) {
   std::vector<std::array<int, 3>> faces;
   faces.reserve(static_cast<size_t>(mesh.numTets()) * 4);
   constexpr int kFace[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
@@ -37,50 +103,132 @@ Status TissueCollision::build(const cutting::TetMesh& mesh, const sim::NodeVecto
   }
   std::sort(faces.begin(), faces.end());
   faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
-  std::vector<fcl::Triangle> triangles;
-  triangles.reserve(faces.size());
-  for (const auto& f : faces) triangles.emplace_back(f[0], f[1], f[2]);
+  cutting::Tris out(static_cast<Eigen::Index>(faces.size()), 3);
+  for (size_t f = 0; f < faces.size(); ++f) out.row(static_cast<Eigen::Index>(f)) << faces[f][0], faces[f][1], faces[f][2];
+  return out;
+}
 
-  impl_->vertices.resize(static_cast<size_t>(x.rows()));
-  for (Eigen::Index i = 0; i < x.rows(); ++i) impl_->vertices[static_cast<size_t>(i)] = x.row(i).transpose();
-  impl_->bvh = std::make_shared<fcl::BVHModel<fcl::AABBd>>();
-  if (impl_->bvh->beginModel(static_cast<int>(triangles.size()), static_cast<int>(x.rows())) != fcl::BVH_OK ||
-      impl_->bvh->addSubModel(impl_->vertices, triangles) != fcl::BVH_OK || impl_->bvh->endModel() != fcl::BVH_OK) {
-    impl_->bvh.reset();
+Status TissueCollision::build(const cutting::Tris& faces, const sim::NodeVectors& x, double margin_mm) {
+  impl_->bvh.reset();
+  impl_->margin = std::max(margin_mm, 0.0);
+  impl_->nodes.clear();
+  impl_->num_faces = 0;
+  // Compact numbering: only the faces' nodes are vertices of the hierarchy (the boundary has
+  // far fewer nodes than the mesh, and refit() copies each vertex every step).
+  std::vector<int> local(static_cast<size_t>(x.rows()), -1);
+  std::vector<fcl::Triangle> triangles;
+  triangles.reserve(static_cast<size_t>(faces.rows()));
+  for (Eigen::Index f = 0; f < faces.rows(); ++f) {
+    int v[3];
+    for (int c = 0; c < 3; ++c) {
+      const int node = faces(f, c);
+      if (node < 0 || node >= x.rows()) return Error{"collision: face " + std::to_string(f) + " names a missing node"};
+      if (local[static_cast<size_t>(node)] < 0) {
+        local[static_cast<size_t>(node)] = static_cast<int>(impl_->nodes.size());
+        impl_->nodes.push_back(node);
+      }
+      v[c] = local[static_cast<size_t>(node)];
+    }
+    triangles.emplace_back(v[0], v[1], v[2]);
+  }
+  if (triangles.empty()) return Status::Ok();  // nothing to touch
+  std::vector<fcl::Vector3d> vertices(impl_->nodes.size());
+  for (size_t i = 0; i < impl_->nodes.size(); ++i) vertices[i] = x.row(impl_->nodes[i]).transpose();
+  auto bvh = std::make_shared<Bvh>();
+  if (bvh->beginModel(static_cast<int>(triangles.size()), static_cast<int>(vertices.size())) != fcl::BVH_OK ||
+      bvh->addSubModel(vertices, triangles) != fcl::BVH_OK || bvh->endModel() != fcl::BVH_OK) {
+    impl_->nodes.clear();
     return Error{"collision: cannot build the tissue's bounding volume hierarchy"};
   }
+  impl_->children_after_parents = true;
+  for (int b = 0; b < bvh->getNumBVs(); ++b) {
+    const fcl::BVNode<fcl::AABBd>& n = bvh->getBV(b);
+    if (!n.isLeaf() && (n.leftChild() <= b || n.rightChild() <= b || n.rightChild() >= bvh->getNumBVs())) {
+      impl_->children_after_parents = false;
+    }
+  }
+  impl_->bvh = std::move(bvh);
   impl_->num_faces = static_cast<int>(triangles.size());
+  impl_->refit_x = std::move(vertices);
+  refit(x);  // grow the boxes by the margin
   return Status::Ok();
 }
 
 void TissueCollision::refit(const sim::NodeVectors& x) {
-  if (!impl_->bvh || static_cast<size_t>(x.rows()) != impl_->vertices.size()) return;
-  for (Eigen::Index i = 0; i < x.rows(); ++i) impl_->vertices[static_cast<size_t>(i)] = x.row(i).transpose();
-  impl_->bvh->beginReplaceModel();
-  impl_->bvh->replaceSubModel(impl_->vertices);
-  impl_->bvh->endReplaceModel(true, true);  // refit bottom-up, keep the tree
+  Impl& m = *impl_;
+  Bvh* bvh = m.bvh.get();
+  if (bvh == nullptr) return;
+  ++m.refits;
+  fcl::Vector3d* v = bvh->vertices;
+  for (size_t i = 0; i < m.nodes.size(); ++i) m.refit_x[i] = v[i] = x.row(m.nodes[i]).transpose();
+  if (!m.children_after_parents) {
+    // FCL's own refit (exact boxes; margin ignored, update() then refits every step).
+    // replaceVertex() writes in place; beginReplaceModel() only frees prev_vertices, which a
+    // replace-refitted model never has.
+    bvh->beginReplaceModel();
+    for (size_t i = 0; i < m.nodes.size(); ++i) bvh->replaceVertex(m.refit_x[i]);
+    bvh->endReplaceModel(true, true);  // refit bottom-up, keep the tree
+    return;
+  }
+  // The same bottom-up refit as FCL's endReplaceModel(true, true), as one loop (FCL numbers
+  // a node's children after it, so a backward sweep sees children first; checked by build()),
+  // with the leaf boxes grown by the margin.
+  const fcl::Vector3d grow = fcl::Vector3d::Constant(m.margin);
+  const fcl::Triangle* tris = bvh->tri_indices;
+  for (int b = bvh->getNumBVs() - 1; b >= 0; --b) {
+    fcl::BVNode<fcl::AABBd>& n = bvh->getBV(b);
+    if (n.isLeaf()) {
+      const fcl::Triangle& t = tris[n.primitiveId()];
+      const fcl::Vector3d &p = v[t[0]], &q = v[t[1]], &r = v[t[2]];
+      n.bv.min_ = p.cwiseMin(q).cwiseMin(r) - grow;
+      n.bv.max_ = p.cwiseMax(q).cwiseMax(r) + grow;
+    } else {
+      const fcl::AABBd& a = bvh->getBV(n.leftChild()).bv;
+      const fcl::AABBd& c = bvh->getBV(n.rightChild()).bv;
+      n.bv.min_ = a.min_.cwiseMin(c.min_);
+      n.bv.max_ = a.max_.cwiseMax(c.max_);
+    }
+  }
 }
 
-bool TissueCollision::touches(const Eigen::Matrix<double, Eigen::Dynamic, 3>& wire, double radius) const {
-  if (!impl_->bvh) return false;
-  fcl::CollisionRequestd request(1, false);
-  fcl::CollisionResultd result;
-  const fcl::Transform3d identity = fcl::Transform3d::Identity();
-  for (Eigen::Index i = 0; i + 1 < wire.rows(); ++i) {
-    const Eigen::Vector3d a = wire.row(i).transpose(), b = wire.row(i + 1).transpose();
-    const Eigen::Vector3d d = b - a;
-    const double len = d.norm();
-    // FCL's capsule lies along its z axis, centred at the origin.
-    fcl::Capsuled capsule(radius, len);
-    fcl::Transform3d pose = fcl::Transform3d::Identity();
-    pose.translation() = 0.5 * (a + b);
-    if (len > 1e-12) {
-      pose.linear() = Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), d / len).toRotationMatrix();
-    }
-    result.clear();
-    if (fcl::collide(&capsule, pose, impl_->bvh.get(), identity, request, result) > 0) return true;
+bool TissueCollision::update(const sim::NodeVectors& x) {
+  Impl& m = *impl_;
+  Bvh* bvh = m.bvh.get();
+  if (bvh == nullptr) return false;
+  if (!m.children_after_parents || m.margin <= 0.0) {
+    refit(x);
+    return true;
   }
-  return false;
+  // The narrow phase reads the vertices, so they always move; the boxes only when a vertex
+  // has left its margin since the last refit.
+  fcl::Vector3d* v = bvh->vertices;
+  const double limit = m.margin * m.margin;
+  bool stale = false;
+  for (size_t i = 0; i < m.nodes.size(); ++i) {
+    v[i] = x.row(m.nodes[i]).transpose();
+    stale = stale || (v[i] - m.refit_x[i]).squaredNorm() > limit;
+  }
+  if (stale) refit(x);
+  return stale;
+}
+
+bool TissueCollision::touches(const SweptWire& sweep, double radius) const {
+  Bvh* tissue = impl_->bvh.get();
+  Bvh* wire = sweep.impl_->bvh.get();
+  if (tissue == nullptr || wire == nullptr) return false;
+  // The traversal node is built here rather than through fcl::distance(), whose AABB path
+  // copies both models per call. Identity poses: initialize() transforms nothing.
+  fcl::detail::MeshDistanceTraversalNode<fcl::AABBd> node;
+  fcl::Transform3d tf_tissue = fcl::Transform3d::Identity(), tf_wire = fcl::Transform3d::Identity();
+  fcl::DistanceRequestd request(false);  // no nearest points
+  fcl::DistanceResultd result;
+  // Start from the threshold: box pairs farther apart than the radius are pruned, and the
+  // first pair of triangles that touches (distance 0) prunes everything left.
+  const double threshold = std::max(radius, 0.0) + 1e-12;  // touching counts (radius 0: crossing)
+  result.min_distance = threshold;
+  if (!fcl::detail::initialize(node, *tissue, tf_tissue, *wire, tf_wire, request, result)) return false;
+  fcl::detail::distance(&node);
+  return result.min_distance < threshold;
 }
 
 }  // namespace hysim::engine

@@ -124,6 +124,9 @@ Status Simulation::setTopology(cutting::TetMesh rest_mesh, const sim::NodeVector
     if (!model_.fixed[node]) contact_nodes_.push_back(node);
   }
   contact_force_ = sim::NodeVectors::Zero(mesh_.numNodes(), 3);
+  // The boundary's hierarchy, with boxes grown by half a millimetre: while the tissue near
+  // the loop moves less than that, a step only moves the vertices (see collision.hpp).
+  if (Status st = collision_.build(surface_faces_, state_.x, 0.5); !st.ok()) return st;
   locator_.build(mesh_, state_.x);
   ++topology_version_;
   return Status::Ok();
@@ -146,6 +149,7 @@ Result<std::unique_ptr<Simulation>> Simulation::create(const Scene& scene) {
   s->loop_.drop_mm = scene.contact.loop_drop_mm;
   loopPoints(s->loop_, s->pose_, s->wire_);  // sizes the wire buffers once
   s->previous_wire_ = s->wire_;
+  s->swept_wire_.reset(static_cast<int>(s->wire_.rows()));
   s->sweep_.reserve(10000, static_cast<int>(s->wire_.rows()));  // a 10 s pass without allocating
   if (Status st = s->setTopology(s->mesh_, nullptr, nullptr); !st.ok()) return Error{scene.path + ": " + st.error()};
   // The serosa of the initial mesh; exact distances are needed up to margin + wire radius.
@@ -198,12 +202,14 @@ void Simulation::computeContact() {
   }
 }
 
-bool Simulation::wireInTissue() {
+bool Simulation::loopTouchesTissue() {
+  collision_.update(state_.x);
+  swept_wire_.update(previous_wire_, wire_);
+  if (collision_.touches(swept_wire_, loop_.wire_radius_mm)) return true;
+  // The sweep meets no boundary face: the wire (connected, part of the sweep) is wholly
+  // inside or wholly outside the tissue, and one of its points tells which.
   if (locator_.maxDisplacement(state_.x) > locator_.margin()) locator_.build(mesh_, state_.x);
-  for (Eigen::Index i = 0; i < wire_.rows(); ++i) {
-    if (locator_.locate(mesh_, state_.x, wire_.row(i).transpose()) >= 0) return true;
-  }
-  return false;
+  return locator_.locate(mesh_, state_.x, wire_.row(wire_.rows() / 2).transpose()) >= 0;
 }
 
 void Simulation::step() {
@@ -218,8 +224,10 @@ void Simulation::step() {
   sim::step(model_, state_, input);
   device_->commandForce(tool_force_n_);  // clamped and NaN-guarded by the device
 
-  // Shaving: entry is the first step the active loop is in the tissue; the sweep grows while
-  // it stays there; on exit (or pedal release) the sweep is cut.
+  // Shaving: entry is the first contact of the active loop with the tissue (its sweep over
+  // this step touches the surface, or it is buried); the sweep grows while it touches; on
+  // exit (no contact any more, or pedal release) the sweep is cut. Collision runs only while
+  // the electrode is active or a pass is open.
   previous_wire_ = wire_;
   loopPoints(loop_, pose_, wire_);
   if (pose_.pedal) {
@@ -231,7 +239,7 @@ void Simulation::step() {
     loop_in_tissue_ = false;
     return;
   }
-  loop_in_tissue_ = pose_.pedal && wireInTissue();
+  loop_in_tissue_ = pose_.pedal && loopTouchesTissue();
   if (loop_in_tissue_ && !cutting_) {
     cutting_ = true;
     sweep_.clear();

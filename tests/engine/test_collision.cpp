@@ -1,6 +1,9 @@
-// Loop electrode vs. tissue (FCL): entry and exit on a slab, inside counts as touching.
+// Loop electrode vs. tissue (FCL): the swept wire of one step against the tissue's surface.
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
+
+#include "alloc_counter.hpp"
 #include "box_mesh.hpp"
 #include "hysim/engine/collision.hpp"
 #include "hysim/engine/tool.hpp"
@@ -15,8 +18,8 @@ cutting::TetMesh slab() {
   return m;
 }
 
-// The tool points down (-z) so the loop hangs sideways; its wire's points are at the height
-// of the tip minus reach.
+// The tool points down (-z) so the loop lies in a horizontal plane; its wire's points are at
+// the height of the tip minus reach.
 haptics::ToolPose poseAt(double height) {
   haptics::ToolPose pose;
   pose.rotation = haptics::frameFromAxisUp({0, 0, -1}, {0, 1, 0});
@@ -24,49 +27,189 @@ haptics::ToolPose poseAt(double height) {
   return pose;
 }
 
-TEST(Collision, EntryInsideAndExitThroughASlab) {
-  const cutting::TetMesh mesh = slab();
-  sim::NodeVectors x = mesh.X;
-  TissueCollision collision;
-  ASSERT_TRUE(collision.build(mesh, x).ok());
-  EXPECT_GT(collision.numFaces(), 2 * mesh.numTets());  // interior faces are in the hierarchy
+WirePoints wireAt(const LoopGeometry& loop, double wire_z, double x = 0.0) {
+  haptics::ToolPose pose = poseAt(wire_z + loop.reach_mm);
+  pose.tip.x() = x;
+  WirePoints wire;
+  loopPoints(loop, pose, wire);
+  return wire;
+}
+
+double triangleArea(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
+  return 0.5 * (b - a).cross(c - a).norm();
+}
+
+TEST(Collision, SweptWireIsTheStripBetweenTwoWirePositions) {
   LoopGeometry loop;
-  Eigen::Matrix<double, Eigen::Dynamic, 3> wire;
-  // Lower the loop through the slab: the wire sits at z = tip - reach (perpendicular loop).
-  bool was_touching = false;
-  double entry = 0, exit = 0;
-  for (int k = 0; k <= 400; ++k) {
-    const double wire_z = 10.0 - 0.05 * k;  // from 10 down to -10
-    loopPoints(loop, poseAt(wire_z + loop.reach_mm), wire);
-    const bool touching = collision.touches(wire, loop.wire_radius_mm);
-    if (touching && !was_touching) entry = wire_z;
-    if (!touching && was_touching) exit = wire_z;
-    was_touching = touching;
+  const WirePoints before = wireAt(loop, 2.0), after = wireAt(loop, 1.5);  // 0.5 mm down
+  SweptWire sweep;
+  sweep.reset(static_cast<int>(before.rows()));
+  ASSERT_EQ(sweep.numPoints(), loop.segments + 1);
+  ASSERT_EQ(sweep.numTriangles(), 2 * loop.segments);
+  sweep.update(before, after);
+  // Segment i's quad: triangles 2i (prev i, prev i+1, current i+1) and 2i+1 (prev i,
+  // current i+1, current i). The motion is perpendicular to the loop's plane, so each quad is
+  // a rectangle: its area is the segment's length times 0.5 mm.
+  double wire_length = 0.0, area = 0.0;
+  for (int i = 0; i < loop.segments; ++i) {
+    Eigen::Vector3d a, b, c;
+    sweep.triangle(2 * i, a, b, c);
+    EXPECT_TRUE(a.isApprox(before.row(i).transpose()));
+    EXPECT_TRUE(b.isApprox(before.row(i + 1).transpose()));
+    EXPECT_TRUE(c.isApprox(after.row(i + 1).transpose()));
+    area += triangleArea(a, b, c);
+    sweep.triangle(2 * i + 1, a, b, c);
+    EXPECT_TRUE(a.isApprox(before.row(i).transpose()));
+    EXPECT_TRUE(b.isApprox(after.row(i + 1).transpose()));
+    EXPECT_TRUE(c.isApprox(after.row(i).transpose()));
+    area += triangleArea(a, b, c);
+    wire_length += (before.row(i + 1) - before.row(i)).norm();
   }
-  EXPECT_NEAR(entry, 4.0 + loop.wire_radius_mm, 0.051);   // first touch of the top face
-  EXPECT_NEAR(exit, -4.0 - loop.wire_radius_mm, 0.051);   // leaves through the bottom
-  // Deep inside the slab the wire touches interior faces only.
-  loopPoints(loop, poseAt(0.3 + loop.reach_mm), wire);
-  EXPECT_TRUE(collision.touches(wire, loop.wire_radius_mm));
+  EXPECT_NEAR(area, 0.5 * wire_length, 1e-9);
+  // A semicircle of radius 3.5 as 16 chords.
+  EXPECT_NEAR(wire_length, 3.14159265358979 * loop.loop_radius_mm, 0.02);
+}
+
+TEST(Collision, BoundaryHierarchyOfASlab) {
+  const cutting::TetMesh mesh = slab();
+  TissueCollision collision;
+  ASSERT_TRUE(collision.build(cutting::boundaryFaces(mesh), mesh.X).ok());
+  // 2 triangles per boundary square: 2 * (10*10*2 + 10*4*2 + 10*4*2).
+  EXPECT_EQ(collision.numFaces(), 2 * (200 + 80 + 80));
+  EXPECT_EQ(collision.numVertices(), 11 * 11 * 5 - 9 * 9 * 3);  // interior nodes left out
+  TissueCollision all;
+  ASSERT_TRUE(all.build(allTetFaces(mesh), mesh.X).ok());
+  EXPECT_GT(all.numFaces(), 2 * mesh.numTets());
+  EXPECT_EQ(all.numVertices(), mesh.numNodes());
+}
+
+// Lower the loop through the slab in 0.05 mm steps: the swept wire touches the top face on
+// the way in and the bottom face on the way out, and nothing of the surface while inside.
+TEST(Collision, SweptWireTouchesTheSurfaceOnEntryAndExit) {
+  const cutting::TetMesh mesh = slab();
+  TissueCollision collision;
+  ASSERT_TRUE(collision.build(cutting::boundaryFaces(mesh), mesh.X).ok());
+  LoopGeometry loop;
+  const double r = loop.wire_radius_mm;
+  SweptWire sweep;
+  sweep.reset(loop.segments + 1);
+  WirePoints previous = wireAt(loop, 10.0);
+  int contacts = 0;
+  double first_in = 0, last_in = 0, first_out = 0, last_out = 0;
+  for (int k = 1; k <= 400; ++k) {
+    const double z = 10.0 - 0.05 * k;  // from 10 down to -10
+    const WirePoints wire = wireAt(loop, z);
+    sweep.update(previous, wire);
+    const bool touching = collision.touches(sweep, r);
+    if (touching) {
+      if (z > 0) {
+        if (first_in == 0) first_in = z;
+        last_in = z;
+      } else {
+        if (first_out == 0) first_out = z;
+        last_out = z;
+      }
+      ++contacts;
+    }
+    previous = wire;
+  }
+  // The strip from z + 0.05 down to z, thickened by r, touches the top face (z = 4) while
+  // z - r <= 4 <= z + 0.05 + r, and the bottom face likewise.
+  EXPECT_NEAR(first_in, 4.0 + r, 0.051);
+  EXPECT_NEAR(last_in, 4.0 - r - 0.05, 0.051);
+  EXPECT_NEAR(first_out, -4.0 + r, 0.051);
+  EXPECT_NEAR(last_out, -4.0 - r - 0.05, 0.051);
+  EXPECT_LT(contacts, 30);  // nothing in between: the inside is no surface
+}
+
+TEST(Collision, AWireAtRestTouchesWithinItsRadius) {
+  const cutting::TetMesh mesh = slab();
+  TissueCollision collision;
+  ASSERT_TRUE(collision.build(cutting::boundaryFaces(mesh), mesh.X).ok());
+  LoopGeometry loop;
+  const double r = loop.wire_radius_mm;
+  SweptWire sweep;
+  sweep.reset(loop.segments + 1);
+  // A wire that does not move sweeps degenerate quads (segments): the distance still counts.
+  for (double gap : {2.0, 0.5, r + 0.01}) {
+    const WirePoints wire = wireAt(loop, 4.0 + gap);
+    sweep.update(wire, wire);
+    EXPECT_FALSE(collision.touches(sweep, r)) << gap;
+  }
+  for (double gap : {r - 0.01, 0.0, -0.1}) {
+    const WirePoints wire = wireAt(loop, 4.0 + gap);
+    sweep.update(wire, wire);
+    EXPECT_TRUE(collision.touches(sweep, r)) << gap;
+  }
   // Far to the side: nothing.
-  haptics::ToolPose away = poseAt(loop.reach_mm);
-  away.tip.x() = 40;
-  loopPoints(loop, away, wire);
-  EXPECT_FALSE(collision.touches(wire, loop.wire_radius_mm));
+  const WirePoints away = wireAt(loop, 0.0, 40.0);
+  sweep.update(away, away);
+  EXPECT_FALSE(collision.touches(sweep, r));
+}
+
+// A wire that jumps through the whole slab in one step (both positions outside) is caught by
+// its sweep.
+TEST(Collision, AFastMotionThroughTheSlabIsNotMissed) {
+  const cutting::TetMesh mesh = slab();
+  TissueCollision collision;
+  ASSERT_TRUE(collision.build(cutting::boundaryFaces(mesh), mesh.X).ok());
+  LoopGeometry loop;
+  SweptWire sweep;
+  sweep.reset(loop.segments + 1);
+  const WirePoints above = wireAt(loop, 6.0), below = wireAt(loop, -6.0);
+  sweep.update(above, above);
+  EXPECT_FALSE(collision.touches(sweep, loop.wire_radius_mm));
+  sweep.update(below, below);
+  EXPECT_FALSE(collision.touches(sweep, loop.wire_radius_mm));
+  sweep.update(above, below);
+  EXPECT_TRUE(collision.touches(sweep, loop.wire_radius_mm));
 }
 
 TEST(Collision, RefitFollowsTheDeformation) {
   const cutting::TetMesh mesh = slab();
   sim::NodeVectors x = mesh.X;
   TissueCollision collision;
-  ASSERT_TRUE(collision.build(mesh, x).ok());
+  ASSERT_TRUE(collision.build(cutting::boundaryFaces(mesh), x).ok());
   LoopGeometry loop;
-  Eigen::Matrix<double, Eigen::Dynamic, 3> wire;
-  loopPoints(loop, poseAt(6.0 + loop.reach_mm), wire);  // 2 mm above the slab
-  EXPECT_FALSE(collision.touches(wire, loop.wire_radius_mm));
-  x.col(2).array() += 3.0;  // the tissue rises by 3 mm
+  SweptWire sweep;
+  sweep.reset(loop.segments + 1);
+  const WirePoints wire = wireAt(loop, 6.0);  // 2 mm above the slab
+  sweep.update(wire, wire);
+  EXPECT_FALSE(collision.touches(sweep, loop.wire_radius_mm));
+  x.col(2).array() += 1.9;  // the tissue rises by 1.9 mm: 0.1 mm below the wire
   collision.refit(x);
-  EXPECT_TRUE(collision.touches(wire, loop.wire_radius_mm));
+  EXPECT_TRUE(collision.touches(sweep, loop.wire_radius_mm));
+  x.col(2).array() += 2.0;  // further: the wire is inside, away from the surface
+  collision.refit(x);
+  EXPECT_FALSE(collision.touches(sweep, loop.wire_radius_mm));
+  x.col(2).array() -= 3.9;
+  collision.refit(x);
+  EXPECT_FALSE(collision.touches(sweep, loop.wire_radius_mm));
+}
+
+TEST(Collision, RefitUpdateAndQueryAllocateNothing) {
+  const cutting::TetMesh mesh = slab();
+  sim::NodeVectors x = mesh.X;
+  TissueCollision collision;
+  ASSERT_TRUE(collision.build(cutting::boundaryFaces(mesh), x).ok());
+  LoopGeometry loop;
+  SweptWire sweep;
+  sweep.reset(loop.segments + 1);
+  const WirePoints a = wireAt(loop, 4.1), b = wireAt(loop, 3.9);
+  int touching = 0;
+  long count = 0;
+  {
+    testing::AllocationCounter counter;
+    for (int i = 0; i < 10; ++i) {
+      x(0, 2) += 1e-3;
+      collision.refit(x);
+      sweep.update(a, b);
+      touching += collision.touches(sweep, loop.wire_radius_mm) ? 1 : 0;
+    }
+    count = counter.count();
+  }
+  EXPECT_EQ(touching, 10);
+  EXPECT_EQ(count, 0);
 }
 
 }  // namespace

@@ -103,9 +103,85 @@ TEST(Shaving, NoCutWhileThePedalIsOff) {
   auto sim = Simulation::create(*scene);
   ASSERT_TRUE(sim.ok()) << sim.error();
   const int elements = (*sim)->mesh().numTets();
-  for (int i = 0; i < 1300; ++i) (*sim)->step();
+  const long refits = (*sim)->collision().numRefits();
+  for (int i = 0; i < 1300; ++i) {
+    (*sim)->step();
+    EXPECT_FALSE((*sim)->loopInTissue());
+  }
   EXPECT_TRUE((*sim)->passes().empty());
   EXPECT_EQ((*sim)->mesh().numTets(), elements);
+  // The inactive loop costs no collision work: the hierarchy was never touched.
+  EXPECT_EQ((*sim)->collision().numRefits(), refits);
+}
+
+// Entry is the first contact of the active loop's sweep with the slab's end face (x = 15),
+// exit the first step whose sweep no longer touches after leaving through x = -15. The wire
+// (plane x = tip + 12) moves at -40 mm/s from x = 20 at t = 0.05 s; wire radius 0.15 mm.
+TEST(Shaving, EntryAndExitAtTheSlabsFaces) {
+  auto scene = loadScene(writeSlabScene(true));
+  ASSERT_TRUE(scene.ok()) << scene.error();
+  auto sim = Simulation::create(*scene);
+  ASSERT_TRUE(sim.ok()) << sim.error();
+  int entry_step = -1, last_in_step = -1;
+  for (int i = 0; i < 1300; ++i) {
+    (*sim)->step();
+    if ((*sim)->loopInTissue()) {
+      if (entry_step < 0) entry_step = i;
+      last_in_step = i;
+    }
+  }
+  // Step i ends at t = (i + 1) ms. Touching from wire x <= 15.15 (t >= 0.17125 s) ...
+  EXPECT_NEAR(entry_step, 171, 1);
+  // ... to the last sweep within 0.15 mm of x = -15 (wire x up to -15.19, t < 0.92975 s).
+  EXPECT_NEAR(last_in_step, 928, 1);
+  ASSERT_EQ((*sim)->passes().size(), 1u);
+  EXPECT_NEAR((*sim)->passes()[0].time_s, 0.930, 0.0015);
+}
+
+// The pedal goes down while the whole loop is buried in the slab (no surface near the wire):
+// the point-in-tissue test makes that an entry on the first step.
+TEST(Shaving, ABuriedLoopEntersWhenThePedalGoesDown) {
+  const fs::path dir = fs::path(HYSIM_TEST_OUTPUT_DIR) / "shaving";
+  writeSlabScene(true);  // writes slab.msh
+  std::ofstream(dir / "slab_buried.yaml")
+      << "name: slab buried\n"
+         "mesh: slab.msh\n"
+         "materials:\n"
+         "  - {name: myoma, label: 1, young_modulus_kpa: 150, density_g_cm3: 1.1}\n"
+         "anchors:\n"
+         "  - box: {min: [-20, -20, -11], max: [20, 20, -9.5]}\n"
+         "simulation: {dt_ms: 1.0, steps: 900, drag_per_s: 30, gravity_mm_s2: [0, 0, 0]}\n"
+         "contact: {enabled: false}\n"
+         "tool_path:\n"
+         // Loop centre 2 mm below the top (z = -2), wire from z = -5.5 to -2, at x = 12.
+         "  - {t_s: 0.0, tip: [0, 0, 1], axis: [1, 0, 0], up: [0, 0, 1], pedal: true}\n"
+         "  - {t_s: 0.8, tip: [-32, 0, 1], axis: [1, 0, 0], up: [0, 0, 1], pedal: true}\n"
+         "  - {t_s: 0.9, tip: [-32, 0, 1], axis: [1, 0, 0], up: [0, 0, 1]}\n";
+  auto scene = loadScene((dir / "slab_buried.yaml").string());
+  ASSERT_TRUE(scene.ok()) << scene.error();
+  auto sim = Simulation::create(*scene);
+  ASSERT_TRUE(sim.ok()) << sim.error();
+  (*sim)->step();
+  EXPECT_TRUE((*sim)->loopInTissue());
+  for (int i = 1; i < 900; ++i) (*sim)->step();
+  EXPECT_FALSE((*sim)->loopInTissue());
+  EXPECT_EQ((*sim)->passes().size(), 1u);  // left through x = -15 (wire x = tip + 12)
+}
+
+TEST(Shaving, SamePassTwiceGivesTheSameState) {
+  auto scene = loadScene(writeSlabScene(true));
+  ASSERT_TRUE(scene.ok()) << scene.error();
+  auto a = Simulation::create(*scene);
+  auto b = Simulation::create(*scene);
+  ASSERT_TRUE(a.ok() && b.ok());
+  for (int i = 0; i < 1000; ++i) {
+    (*a)->step();
+    (*b)->step();
+    ASSERT_EQ((*a)->loopInTissue(), (*b)->loopInTissue()) << i;
+  }
+  ASSERT_EQ((*a)->passes().size(), 1u);
+  EXPECT_EQ((*a)->mesh().numTets(), (*b)->mesh().numTets());
+  EXPECT_EQ((*a)->stateHash(), (*b)->stateHash());
 }
 
 }  // namespace

@@ -1,17 +1,30 @@
 #pragma once
-// Loop electrode vs. tissue, with FCL. The tissue's bounding volume hierarchy holds every
-// tet face, interior ones included: a wire that is inside the tissue crosses interior faces
-// (the loop, ~11 mm of wire, is longer than any tet, ~4 mm), so "touches a face" means "in
-// or on the tissue". The hierarchy is refitted as the tissue deforms and rebuilt after a
-// topology change.
+// Loop electrode vs. tissue, with FCL: the volume the wire swept in one step against the
+// tissue's surface.
 //
-// Cost on the default mesh (26k faces, AABB tree; ./build/bench/bench_collision): refit
-// ~0.9 ms, a touching query ~0.7 ms. Callgrind shows why the query is slow: for a
-// non-oriented BV (AABB), FCL 0.7's shape-vs-mesh collide copies the BVHModel and rebuilds
-// its tree on every call (BVHModel copy + recursiveBuildTree dominate). Oriented BVs
-// (OBBRSS) avoid the copy but their refit took ~49 ms. Too slow for every 1 ms step as it
-// stands; the shaving loop needs a broadphase that updates incrementally (e.g. FCL's
-// dynamic AABB tree over tets with fat boxes) or a hierarchy limited to the reachable region.
+// SweptWire is that volume: per wire segment the quad between its previous and current
+// positions (2 triangles), a small FCL hierarchy whose vertices are replaced and whose
+// boxes are refitted in place every step. TissueCollision holds an AABB hierarchy of the
+// tissue's boundary triangles, refitted in place (same tree) while the electrode is active
+// and rebuilt after a topology change. touches() is an FCL mesh-mesh distance traversal that
+// stops at the first pair of triangles closer than the wire radius (that is the thickening).
+//
+// The boundary is enough: if the swept volume meets no boundary triangle, the wire lies
+// wholly inside or wholly outside the tissue (a connected set that crosses no surface), so one
+// point-in-tissue test (TetLocator) settles the "buried loop" case.
+//
+// Which FCL paths copy (FCL 0.7, collision_func_matrix-inl.h / distance_func_matrix-inl.h):
+// fcl::collide / fcl::distance with a non-oriented BV (AABB) copy the BVHModel(s) with
+// `new BVHModel(*obj)` on every call (shape-vs-mesh and mesh-vs-mesh alike), then rebuild or
+// refit the copy if the pose is not the identity: that was the earlier 0.7 ms capsule query.
+// Oriented BVs (OBBRSS) do not copy but their refit is slow (~49 ms for all tet faces). So
+// touches() builds the traversal node itself (fcl::detail::initialize with identity poses
+// transforms nothing and copies nothing) and runs fcl::detail::distance on it: no copy, no
+// allocation.
+//
+// Cost on the shaving scene's mesh (assets/uterus_myoma.msh, ./build/bench/bench_collision,
+// medians of 5 repetitions, 2-core machine shared with other builds): see the table in
+// bench/bench_collision.cpp; refit of the boundary hierarchy ~MEASURED, a query ~MEASURED.
 #include <Eigen/Core>
 #include <memory>
 
@@ -20,6 +33,32 @@
 
 namespace hysim::engine {
 
+using WirePoints = Eigen::Matrix<double, Eigen::Dynamic, 3>;  // #P x 3 polyline
+
+// The loop wire's motion in one step, as triangles (previous row, current row).
+class SweptWire {
+ public:
+  SweptWire();
+  ~SweptWire();
+  SweptWire(SweptWire&&) noexcept;
+  SweptWire& operator=(SweptWire&&) noexcept;
+
+  // Sizes the hierarchy for wires of `points` points (allocates; once per loop geometry).
+  void reset(int points);
+  // The quads between the wire at `previous` and at `current` (both #P x 3, P = the size
+  // given to reset()). Allocates nothing.
+  void update(const WirePoints& previous, const WirePoints& current);
+  int numPoints() const;
+  int numTriangles() const;  // 2 * (points - 1)
+  // Corners of triangle t (for tests and debugging).
+  void triangle(int t, Eigen::Vector3d& a, Eigen::Vector3d& b, Eigen::Vector3d& c) const;
+
+ private:
+  friend class TissueCollision;
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
 class TissueCollision {
  public:
   TissueCollision();
@@ -27,17 +66,30 @@ class TissueCollision {
   TissueCollision(TissueCollision&&) noexcept;
   TissueCollision& operator=(TissueCollision&&) noexcept;
 
-  // (Re)builds the hierarchy for this mesh at positions x (#N x 3).
-  Status build(const cutting::TetMesh& mesh, const sim::NodeVectors& x);
-  // Moves the hierarchy's vertices to x (same mesh) and refits the bounding volumes.
+  // (Re)builds the hierarchy over the triangles `faces` (#F x 3 node ids into x, e.g. the
+  // tissue's boundary faces) at positions x (#N x 3). Every leaf box is grown by `margin_mm`,
+  // so the boxes stay valid until some vertex has moved that far. Allocates.
+  Status build(const cutting::Tris& faces, const sim::NodeVectors& x, double margin_mm = 0.0);
+  // Moves the hierarchy's vertices to x (same mesh) and refits the boxes bottom-up in place,
+  // keeping the tree. Allocates nothing.
   void refit(const sim::NodeVectors& x);
-  // Does the wire (polyline, #P x 3, thickened to `radius`) touch the tissue?
-  bool touches(const Eigen::Matrix<double, Eigen::Dynamic, 3>& wire, double radius) const;
+  // Moves the vertices to x and refits only if a vertex has moved further than the margin
+  // since the last refit (O(#V) check; a margin of 0 refits every time). Returns whether it
+  // refitted. Allocates nothing.
+  bool update(const sim::NodeVectors& x);
+  // Does the swept wire, thickened by `radius`, touch a triangle? Allocates nothing.
+  bool touches(const SweptWire& sweep, double radius) const;
   int numFaces() const;
+  int numVertices() const;  // distinct nodes of the faces
+  double margin() const;
+  long numRefits() const;   // since construction (build included)
 
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
+
+// All distinct faces of the tets (#F x 3 node ids), interior ones included.
+cutting::Tris allTetFaces(const cutting::TetMesh& mesh);
 
 }  // namespace hysim::engine

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "hysim/cutting/mesh.hpp"
+#include "hysim/engine/collision.hpp"
 #include "hysim/engine/outer_wall.hpp"
 #include "hysim/engine/scene.hpp"
 #include "hysim/engine/tet_locator.hpp"
@@ -77,6 +78,7 @@ class Simulation {
   bool loopInTissue() const { return loop_in_tissue_; }
   const LoopGeometry& loop() const { return loop_; }
   int topologyVersion() const { return topology_version_; }
+  const TissueCollision& collision() const { return collision_; }
   // Metrics of the run so far.
   double initialMyomaVolume() const { return initial_myoma_mm3_; }  // mm^3, rest shape
   double electrodeActiveSeconds() const { return electrode_active_s_; }
@@ -101,7 +103,9 @@ class Simulation {
   // Replaces the mesh (rest positions) and everything built from it; x, v (#N x 3) are the
   // current positions and velocities (null: rest and zero).
   Status setTopology(cutting::TetMesh rest_mesh, const sim::NodeVectors* x, const sim::NodeVectors* v);
-  bool wireInTissue();
+  // Does the loop touch the tissue this step? Its sweep since the last step against the
+  // boundary (FCL), else whether the wire is buried (one point in a tet).
+  bool loopTouchesTissue();
   void finishPass();
   void checkPerforation();
 
@@ -125,6 +129,8 @@ class Simulation {
 
   // Shaving.
   LoopGeometry loop_;
+  TissueCollision collision_;  // boundary faces, refitted only while the electrode is active
+  SweptWire swept_wire_;       // the wire's motion in the last step
   TetLocator locator_;
   Eigen::Matrix<double, Eigen::Dynamic, 3> wire_, previous_wire_;
   Sweep sweep_;
