@@ -889,6 +889,8 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
     region.on_cut.assign(on.begin(), on.end());
     region.on_cut.resize(N1, 1);
     region.seeds = cutNodes;
+    for (const auto& ce : crossed)
+      region.edge_length += (input.X.row(ce.a) - input.X.row(ce.b)).norm() / static_cast<double>(crossed.size());
     region.seeds.insert(region.seeds.end(), moved.begin(), moved.end());
     const size_t before = moved.size();
     OptimizeCounts counts;
@@ -896,6 +898,9 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
     report.optimize_iterations = counts.iterations;
     report.peeled_elements = counts.peeled;
     report.collapsed_edges = counts.collapsed;
+    report.late_snaps = counts.late_snaps;
+    cutNodes.insert(cutNodes.end(), counts.onto_cut.begin(), counts.onto_cut.end());
+    std::sort(cutNodes.begin(), cutNodes.end());
     report.peeled_volume = counts.peeled_volume;
     report.optimized_nodes = static_cast<int>(moved.size() - before);
     report.optimize_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - optStart).count();

@@ -41,6 +41,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   dead->assign(M, 0);
   if (region.seeds.empty() || N == 0) return;
   const bool plane = region.surface && region.surface->isPlane();
+  std::vector<std::uint8_t> onCut = region.on_cut;  // grows: nodes snapped onto the cut here
   const double cosFlat = std::cos(options.boundary_flat_deg * M_PI / 180.0);
 
   // Node -> tets of the whole mesh (one O(#T) pass; everything else is local).
@@ -124,10 +125,10 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       if (bf.count != 1) continue;
       boundary = true;
       sum += bf.area;
-      allCut = allCut && region.on_cut[bf.u] && region.on_cut[bf.v];
+      allCut = allCut && onCut[bf.u] && onCut[bf.v];
     }
-    const bool onCut = region.on_cut[n] != 0;
-    if (onCut) {
+    const bool nodeOnCut = onCut[n] != 0;
+    if (nodeOnCut) {
       if (!options.move_cut_nodes || (boundary && !allCut)) return c;  // rim node (or off)
       if (plane) {
         c.kind = Freedom::Plane;
@@ -154,7 +155,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   };
   // A node off the cut stays strictly on its side of the surface.
   auto sideKept = [&](int n, const Vec3& x, const Vec3& y) {
-    if (region.on_cut[n] || region.surface == nullptr) return true;
+    if (onCut[n] || region.surface == nullptr) return true;
     if (plane) {
       const Vec3 pn = region.surface->planeNormal(), pp = region.surface->planePoint();
       const double a = pn.dot(x - pp), b = pn.dot(y - pp);
@@ -244,6 +245,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     return at == start && visited == edges;
   };
   std::vector<std::int32_t> around;
+  std::vector<std::int32_t> lateSnapped;  // nodes snapNear moved onto the cut
   auto peel = [&]() {
     if (!(options.peel_quality > 0)) return;
     std::vector<std::int32_t> candidates;
@@ -311,10 +313,10 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
           for (int b = a + 1; b < 4; ++b) {
             const int x = mesh.T(t, a), y = mesh.T(t, b);
             const double len = (pos(x) - pos(y)).norm();
-            const bool shortEdge = len < options.collapse_fraction * mean;
+            const bool shortEdge = len < options.collapse_fraction * std::max(mean, region.edge_length);
             if (!shortEdge && q >= options.quality_target) continue;
-            if (region.on_cut[y]) cands.push_back({len, x, y, shortEdge});
-            if (region.on_cut[x]) cands.push_back({len, y, x, shortEdge});
+            if (onCut[y]) cands.push_back({len, x, y, shortEdge});
+            if (onCut[x]) cands.push_back({len, y, x, shortEdge});
           }
       }
       std::sort(cands.begin(), cands.end(), [](const Cand& p, const Cand& q) {
@@ -405,6 +407,105 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       std::fill(locked.begin(), locked.end(), 0);
     }
   };
+  // Late snapping: a node off the cut but within collapse_fraction of the local edge length
+  // of it, with tets whose other three nodes lie on the cut (slivers and short edges no single
+  // edge collapse can remove: collapsing into one cut node flattens the others), moves onto
+  // the cut (its nearest point), and the tets that become flat (all four nodes on the cut) are
+  // removed. Same acceptance as a collapse: nothing inverts, the worst q* around does not
+  // fall, volume within the limits, no non-manifold node.
+  auto snapNear = [&]() {
+    if (!(options.collapse_fraction > 0) || region.surface == nullptr) return;
+    std::vector<std::pair<double, std::int32_t>> cands;
+    for (int n : region.seeds)
+      for (int s = off[n]; s < off[n + 1]; ++s) {
+        const int t = star[s];
+        if ((*dead)[t]) continue;
+        for (int k = 0; k < 4; ++k) {
+          const int u = mesh.T(t, k);
+          if (onCut[u]) continue;
+          const double d = std::abs(region.surface->signedDistance(pos(u)));
+          if (d < options.collapse_fraction * region.edge_length) cands.emplace_back(d, u);
+        }
+      }
+    std::sort(cands.begin(), cands.end());
+    cands.erase(std::unique(cands.begin(), cands.end()), cands.end());
+    std::vector<std::int32_t> dying, changing;
+    std::vector<Vec3> targets;
+    for (const auto& [dist, u] : cands) {
+      if (onCut[u]) continue;
+      // Targets: the nearest point of the cut, then the nearest points of the edges between
+      // two cut nodes around u (for a node on the outer boundary, the rim: it stays on the
+      // boundary's polygonal surface).
+      targets.clear();
+      targets.emplace_back();
+      region.surface->signedDistance(pos(u), &targets.back());
+      for (int s = off[u]; s < off[u + 1]; ++s) {
+        const int t = star[s];
+        if ((*dead)[t]) continue;
+        for (int i = 0; i < 4; ++i)
+          for (int j = i + 1; j < 4; ++j) {
+            const int a = mesh.T(t, i), b = mesh.T(t, j);
+            if (a == u || b == u || !onCut[a] || !onCut[b]) continue;
+            const Vec3 pa = pos(a), ab = pos(b) - pa;
+            const double l2 = ab.squaredNorm();
+            if (l2 > 0) targets.push_back(pa + std::clamp((pos(u) - pa).dot(ab) / l2, 0.1, 0.9) * ab);
+          }
+      }
+      for (const Vec3& y : targets) {
+        if ((y - pos(u)).norm() > options.collapse_fraction * region.edge_length) continue;
+        dying.clear();
+        changing.clear();
+        double oldMin = 1.0, newMin = 1.0, before = 0, after = 0;
+        bool ok = true;
+        for (int s = off[u]; s < off[u + 1] && ok; ++s) {
+          const int t = star[s];
+          if ((*dead)[t]) continue;
+          int others = 0;
+          for (int k = 0; k < 4; ++k) others += mesh.T(t, k) != u && onCut[mesh.T(t, k)];
+          oldMin = std::min(oldMin, tetQ(t));
+          before += tetVolume(mesh, t);
+          if (others == 3) {
+            dying.push_back(t);
+            continue;
+          }
+          changing.push_back(t);
+          const double q = tetQAt(t, u, y);
+          if (q < 0) ok = false;
+          newMin = std::min(newMin, q);
+          Vec3 p[4];
+          for (int k = 0; k < 4; ++k) p[k] = mesh.T(t, k) == u ? y : pos(mesh.T(t, k));
+          after += (p[1] - p[0]).dot((p[2] - p[0]).cross(p[3] - p[0])) / 6.0;
+        }
+        const double change = std::abs(after - before);
+        if (!ok || dying.empty() || changing.empty() || newMin < oldMin ||
+            change > options.collapse_volume_fraction * before || change > budget)
+          continue;
+        const Vec3 x = pos(u);
+        for (int t : dying) (*dead)[t] = 1;
+        mesh.X.row(u) = y.transpose();
+        liveStar(u, around, nullptr);
+        ok = discAround(u, around);
+        for (size_t i = 0; i < dying.size() && ok; ++i)
+          for (int k = 0; k < 4 && ok; ++k) {
+            const int w = mesh.T(dying[i], k);
+            if (w == u) continue;
+            liveStar(w, around, nullptr);
+            ok = discAround(w, around);
+          }
+        if (!ok) {
+          for (int t : dying) (*dead)[t] = 0;
+          mesh.X.row(u) = x.transpose();
+          continue;
+        }
+        onCut[u] = 1;
+        lateSnapped.push_back(u);
+        budget -= change;
+        if (counts) ++counts->late_snaps;
+        break;
+      }
+    }
+  };
+  snapNear();
   collapseEdges();
 
   // Nodes up to `rings` edge steps from the seeds may move.
@@ -543,10 +644,14 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     }
   }
   if (counts) counts->iterations = it;
+  snapNear();  // moves may have made new short edges on the cut
+  collapseEdges();
   peel();
   if (moved)
     for (int n = 0; n < N; ++n)
       if (didMove[n]) moved->push_back(n);
+  if (moved) moved->insert(moved->end(), lateSnapped.begin(), lateSnapped.end());
+  if (counts) counts->onto_cut = lateSnapped;
 }
 
 }  // namespace hysim::cutting

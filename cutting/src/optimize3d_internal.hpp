@@ -14,12 +14,15 @@ struct CutRegion {
   double eps = 0;                       // on-surface tolerance (absolute)
   std::vector<std::int32_t> seeds;      // nodes the cut created, moved or separated
   std::vector<std::uint8_t> on_cut;     // #N of the output mesh: node lies on the cut
+  double edge_length = 0;               // mean length of the crossed edges (the local mesh size)
 };
 
 struct OptimizeCounts {
   int iterations = 0;
   int peeled = 0;
   int collapsed = 0;
+  int late_snaps = 0;
+  std::vector<std::int32_t> onto_cut;  // the nodes late snapping moved onto the cut
   double peeled_volume = 0;
 };
 

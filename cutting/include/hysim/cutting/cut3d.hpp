@@ -43,7 +43,10 @@ namespace hysim::cutting {
 // where their boundary is flat (move_boundary_nodes, boundary_flat_deg), perpendicular to
 // their area-weighted normal, which keeps the volume exactly. Nodes whose neighbours moved
 // are tried again; sweeps stop when the largest move is below stop_fraction * mean edge
-// length, or after max_iterations. Before and after the moves, slivers near the cut (q*
+// length, or after max_iterations. Before and after the moves, nodes within collapse_fraction
+// of the local edge length of the cut that have tets with three nodes on it move onto it (the
+// tets that go flat are removed), and short or poor edges with an end on the cut collapse
+// into that end (see optimize3d.cpp). Slivers near the cut (q*
 // below peel_quality) with a boundary face are peeled off (removed) where the mesh stays
 // manifold: flat tets left where the cut meets the boundary at a shallow angle, which no move
 // can repair; their volume is tiny (Cut3DReport::peeled_volume). 0 disables peeling.
@@ -127,6 +130,7 @@ struct Cut3DReport {
   int cut_faces = 0;          // interior faces on the cut (now separated)
   int optimized_nodes = 0;
   int collapsed_edges = 0;    // edges on the cut collapsed by the optimisation
+  int late_snaps = 0;         // nodes near the cut the optimisation moved onto it
   int peeled_elements = 0;    // slivers removed by the optimisation
   double peeled_volume = 0;   // their volume
   int optimize_iterations = 0;
