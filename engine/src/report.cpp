@@ -76,6 +76,13 @@ Result<RunReport> run(Simulation& sim, const RunOptions& options) {
   r.initial_myoma_mm3 = sim.initialMyomaVolume();
   r.electrode_active_s = sim.electrodeActiveSeconds();
   r.path_length_mm = sim.pathLengthMm();
+  if (const ChipWorld* chips = sim.chips(); chips != nullptr) {
+    r.chips_mode = "simulate";
+    r.chips_in_cavity = chips->numChips();
+    r.chips_left_cavity = chips->removedOutside();
+    r.chips_over_cap = chips->removedOverCap();
+    r.chip_step_us_mean = sim.chipSteps() > 0 ? 1e6 * sim.chipStepSeconds() / static_cast<double>(sim.chipSteps()) : 0.0;
+  }
   return r;
 }
 
@@ -136,6 +143,8 @@ std::string reportJson(const RunReport& r) {
   j["path_length_mm"] = r.path_length_mm;
   j["passes"] = r.passes.size();
   j["cut_ms"] = {{"median", percentile(cut_ms, 0.5)}, {"max", cut_ms.empty() ? 0.0 : *std::max_element(cut_ms.begin(), cut_ms.end())}};
+  j["chips"] = {{"mode", r.chips_mode}, {"in_cavity", r.chips_in_cavity}, {"left_cavity", r.chips_left_cavity},
+                {"over_cap", r.chips_over_cap}, {"step_us_mean", r.chip_step_us_mean}};
   j["per_pass"] = per_pass;
   return j.dump(2) + "\n";
 }

@@ -36,6 +36,11 @@ struct RunReport {
   double initial_myoma_mm3 = 0.0;
   double electrode_active_s = 0.0;
   double path_length_mm = 0.0;
+  // Chips (scene `chips`): mode, simulated chips in the cavity at the end, chips that left
+  // it, chips dropped over the cap, and the mean wall time of a chip step (Bullet), us.
+  std::string chips_mode = "remove";
+  int chips_in_cavity = 0, chips_left_cavity = 0, chips_over_cap = 0;
+  double chip_step_us_mean = 0.0;
 };
 
 Result<RunReport> run(Simulation& simulation, const RunOptions& options);
