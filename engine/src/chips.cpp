@@ -1,5 +1,6 @@
 #include "hysim/engine/chips.hpp"
 
+#include <BulletCollision/CollisionShapes/btShapeHull.h>
 #include <btBulletDynamicsCommon.h>
 
 #include <Eigen/Geometry>
@@ -39,6 +40,14 @@ void mix(std::uint64_t& h, const void* data, size_t n) {
 constexpr double kMaxSubstep = 1e-3;    // s
 constexpr double kLeaveMarginMm = 10.0;  // outside the cavity's bounding box: gone
 constexpr double kMinChipVolume = 1e-3;  // mm^3: smaller pieces are not simulated
+constexpr int kMaxHullPoints = 32;       // more hull corners are reduced (contact cost)
+// A chip slower than these for kSleepSeconds sleeps (no contact work) until something
+// touches it. Bullet's defaults (0.8 and 1.0 for 2 s) are for metres and for scenes that do
+// not change every two seconds; chips are millimetres wide and the contact jitter of a
+// resting one is a few mm/s. The time is Bullet's global gDeactivationTime (Bullet is used
+// for nothing else in the process).
+constexpr float kSleepLinearMmS = 2.0f, kSleepAngularRadS = 0.5f, kSleepSeconds = 0.5f;
+constexpr double kWakeMarginMm = 2.0;  // chips this close to a new chip's box are woken
 
 }  // namespace
 
@@ -102,6 +111,7 @@ ChipWorld::ChipWorld(const ChipSettings& settings, const Eigen::Vector3d& gravit
     : settings_(settings), gravity_(gravity_mm_s2), dt_(dt_s), impl_(std::make_unique<Impl>()) {
   substeps_ = std::max(1, static_cast<int>(std::ceil(dt_ / kMaxSubstep - 1e-9)));
   Impl& m = *impl_;
+  gDeactivationTime = kSleepSeconds;
   m.world.setGravity(toBt(gravity_));
   chips_.reserve(static_cast<size_t>(settings_.max_chips) + 1);
   m.bodies.reserve(static_cast<size_t>(settings_.max_chips) + 1);
@@ -179,7 +189,6 @@ void ChipWorld::setCavity(const sim::NodeVectors& x, const cutting::Tris& faces)
   info.m_friction = static_cast<btScalar>(settings_.friction);
   m.cavity_body = std::make_unique<btRigidBody>(info);
   m.world.addRigidBody(m.cavity_body.get());
-  for (Impl::Body& b : m.bodies) b.body->activate(true);
 }
 
 int ChipWorld::addChip(const ChipShape& shape) {
@@ -192,6 +201,18 @@ int ChipWorld::addChip(const ChipShape& shape) {
   }
   b.shape->recalcLocalAabb();
   b.shape->optimizeConvexHull();  // only the hull's corners remain
+  if (b.shape->getNumPoints() > kMaxHullPoints) {
+    // A rounded chip has many corners, and every contact query walks all of them: keep the
+    // hull's support points in a fixed set of directions (Bullet's btShapeHull, <= 42).
+    btShapeHull simple(b.shape.get());
+    if (simple.buildHull(0.0f) && simple.numVertices() >= 4) {
+      auto reduced = std::make_unique<btConvexHullShape>();
+      for (int i = 0; i < simple.numVertices(); ++i) reduced->addPoint(simple.getVertexPointer()[i], false);
+      reduced->recalcLocalAabb();
+      reduced->optimizeConvexHull();
+      b.shape = std::move(reduced);
+    }
+  }
   if (b.shape->getNumPoints() < 4) return -1;
   const btScalar mass = static_cast<btScalar>(shape.mass_g);
   btVector3 inertia(0, 0, 0);
@@ -203,6 +224,8 @@ int ChipWorld::addChip(const ChipShape& shape) {
   info.m_angularDamping = static_cast<btScalar>(1.0 - std::exp(-settings_.angular_drag_per_s));
   info.m_friction = static_cast<btScalar>(settings_.friction);
   info.m_restitution = 0.0;
+  info.m_linearSleepingThreshold = kSleepLinearMmS;
+  info.m_angularSleepingThreshold = kSleepAngularRadS;
   b.body = std::make_unique<btRigidBody>(info);
   m.world.addRigidBody(b.body.get());
   // Gravity less buoyancy (the cavity is filled with distension fluid).
@@ -230,6 +253,15 @@ int ChipWorld::addChip(const ChipShape& shape) {
   }
   chip.surface.material = shape.material;
   chip.surface.material.resize(static_cast<size_t>(nv), render::SurfaceMaterial::Cut);
+  // The cut took away the material of the new chip: chips that rested on it wake up.
+  btVector3 lo, hi;
+  b.body->getAabb(lo, hi);
+  const btVector3 margin(kWakeMarginMm, kWakeMarginMm, kWakeMarginMm);
+  for (Impl::Body& other : m.bodies) {
+    btVector3 olo, ohi;
+    other.body->getAabb(olo, ohi);
+    if (TestAabbAgainstAabb2(lo - margin, hi + margin, olo, ohi)) other.body->activate(true);
+  }
   m.bodies.push_back(std::move(b));
   chips_.push_back(std::move(chip));
   ++version_;

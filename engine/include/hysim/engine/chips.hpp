@@ -60,9 +60,10 @@ class ChipWorld {
   ChipWorld& operator=(const ChipWorld&) = delete;
 
   // The static cavity: boundary triangles (#B x 3 rows of x) in the positions x (#N x 3).
-  // Allocates (a cut step). Wakes every chip (the wall under it may have gone).
+  // Allocates (a cut step). Chips stay asleep: addChip wakes those near the cut.
   void setCavity(const sim::NodeVectors& x, const cutting::Tris& faces);
-  // Adds a chip; the oldest goes when there are more than max_chips. Allocates.
+  // Adds a chip; the oldest goes when there are more than max_chips. Wakes the chips within
+  // 2 mm of its bounding box (the tissue they lay on may have been cut away). Allocates.
   int addChip(const ChipShape& shape);
   // The tool pose at the end of the coming step (the kinematic bodies move there during it).
   void moveTool(const haptics::ToolPose& pose);
