@@ -54,6 +54,7 @@ struct RunArgs {
   int every = -1;
   std::string frames;
   std::string report;
+  std::string chips;  // empty: the scene's
   bool quiet = false;
 };
 
@@ -61,6 +62,8 @@ int runCommand(const RunArgs& args) {
   const std::string scene_path = args.scene.empty() ? tools::defaultScenePath() : args.scene;
   auto scene = engine::loadScene(scene_path);
   if (!scene.ok()) return fail(scene.error());
+  if (args.chips == "remove") scene->chips.mode = engine::ChipSettings::Mode::Remove;
+  if (args.chips == "simulate") scene->chips.mode = engine::ChipSettings::Mode::Simulate;
   auto sim = engine::Simulation::create(*scene);
   if (!sim.ok()) return fail(sim.error());
 
@@ -144,6 +147,8 @@ int main(int argc, char** argv) {
   run_cmd->add_option("--frames", run.frames, "Write PNG frames into this folder");
   run_cmd->add_option("--every", run.every, "Render a frame every K steps (default: the scene's)")->check(CLI::PositiveNumber);
   run_cmd->add_option("--report", run.report, "Write the JSON report to this file");
+  run_cmd->add_option("--chips", run.chips, "Override the scene's chips mode: remove or simulate")
+      ->check(CLI::IsMember({"remove", "simulate"}));
   run_cmd->add_flag("--quiet", run.quiet, "Print nothing but errors");
 
   std::string stats_path;

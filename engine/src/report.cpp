@@ -80,6 +80,13 @@ Result<RunReport> run(Simulation& sim, const RunOptions& options) {
   r.perforations = sim.perforations();
   r.perforation_events = sim.perforationEvents();
   r.serosa_faces = sim.outerWall().numFaces();
+  if (const ChipWorld* chips = sim.chips(); chips != nullptr) {
+    r.chips_mode = "simulate";
+    r.chips_in_cavity = chips->numChips();
+    r.chips_left_cavity = chips->removedOutside();
+    r.chips_over_cap = chips->removedOverCap();
+    r.chip_step_us_mean = sim.chipSteps() > 0 ? 1e6 * sim.chipStepSeconds() / static_cast<double>(sim.chipSteps()) : 0.0;
+  }
   return r;
 }
 
@@ -177,6 +184,8 @@ std::string reportJson(const RunReport& r) {
     events.push_back({{"time_s", e.time_s}, {"end_s", e.end_s}, {"min_distance_mm", e.min_distance_mm}});
   }
   j["perforation_events"] = events;
+  j["chips"] = {{"mode", r.chips_mode}, {"in_cavity", r.chips_in_cavity}, {"left_cavity", r.chips_left_cavity},
+                {"over_cap", r.chips_over_cap}, {"step_us_mean", r.chip_step_us_mean}};
   j["per_pass"] = per_pass;
   return j.dump(2) + "\n";
 }

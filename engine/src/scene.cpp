@@ -176,6 +176,27 @@ void parseContact(const Reader& r, const YAML::Node& n, ContactSettings& c) {
   if (n["loop_drop_mm"]) c.loop_drop_mm = r.number(n["loop_drop_mm"], "loop_drop_mm");
 }
 
+// `chips: remove` / `chips: simulate`, or a mapping with `mode` and the tuning keys.
+void parseChips(const Reader& r, const YAML::Node& n, ChipSettings& c) {
+  auto mode = [&](const YAML::Node& m) {
+    const std::string s = r.string(m, "chips");
+    if (s == "remove") c.mode = ChipSettings::Mode::Remove;
+    else if (s == "simulate") c.mode = ChipSettings::Mode::Simulate;
+    else r.fail(m, "'chips' must be remove or simulate, got '" + s + "'");
+  };
+  if (n.IsScalar()) {
+    mode(n);
+    return;
+  }
+  r.checkKeys(n, "chips", {"mode", "max_chips", "drag_per_s", "angular_drag_per_s", "fluid_density_g_cm3", "friction"});
+  if (n["mode"]) mode(n["mode"]);
+  if (n["max_chips"]) c.max_chips = r.integer(n["max_chips"], "max_chips", 1, 256);
+  if (n["drag_per_s"]) c.drag_per_s = r.nonNegative(n["drag_per_s"], "drag_per_s");
+  if (n["angular_drag_per_s"]) c.angular_drag_per_s = r.nonNegative(n["angular_drag_per_s"], "angular_drag_per_s");
+  if (n["fluid_density_g_cm3"]) c.fluid_density_g_cm3 = r.nonNegative(n["fluid_density_g_cm3"], "fluid_density_g_cm3");
+  if (n["friction"]) c.friction = r.nonNegative(n["friction"], "friction");
+}
+
 haptics::Keyframe parseKeyframe(const Reader& r, const YAML::Node& n, const haptics::Keyframe* previous) {
   r.checkKeys(n, "tool_path[]", {"t_s", "tip", "axis", "up", "extension_mm", "pedal", "move", "arc_center"});
   const double previous_time = previous != nullptr ? previous->time_s : 0.0;
@@ -215,7 +236,7 @@ Scene parse(const Reader& r, const YAML::Node& root, const std::string& path) {
   scene.path = path;
   if (!root.IsDefined() || root.IsNull()) r.fail(root, "the scene file is empty");
   r.checkKeys(root, "scene", {"name", "description", "mesh", "tool_mesh", "materials", "anchors", "simulation",
-                              "contact", "safety", "tool_path", "camera", "render"});
+                              "contact", "safety", "tool_path", "camera", "render", "chips"});
   const fs::path dir = fs::path(path).parent_path();
   auto resolve = [&](const YAML::Node& n, const std::string& key) {
     const std::string rel = r.string(n, key);
@@ -255,6 +276,7 @@ Scene parse(const Reader& r, const YAML::Node& root, const std::string& path) {
       }
     }
   }
+  if (root["chips"]) parseChips(r, root["chips"], scene.chips);
 
   const YAML::Node tp = r.require(root, "tool_path", "scene");
   if (!tp.IsSequence() || tp.size() == 0) r.fail(tp, "'tool_path' must be a non-empty list of keyframes");

@@ -24,6 +24,84 @@ Eigen::Vector3d closestOnSegment(const Eigen::Vector3d& p, const Eigen::Vector3d
   return a + t * ab;
 }
 
+// The free pieces of a cut mesh as chips: surface (current positions), material for
+// drawing, volume, mass, centre of mass and mean velocity. `after` holds the current
+// positions; v (#N x 3) the velocities; on_cut (#N) marks nodes on a cut surface.
+std::vector<ChipShape> chipShapes(const cutting::TetMesh& after, const sim::NodeVectors& v,
+                                  const cutting::Components3D& comps, const std::vector<std::uint8_t>& on_cut,
+                                  const std::vector<sim::Material>& materials, int myoma_label) {
+  std::vector<std::vector<int>> tets(static_cast<size_t>(comps.count));
+  for (int t = 0; t < after.numTets(); ++t) {
+    if (comps.free[comps.label[t]]) tets[comps.label[t]].push_back(t);
+  }
+  std::vector<ChipShape> out;
+  std::vector<int> local(static_cast<size_t>(after.numNodes()), -1);
+  for (int c = 0; c < comps.count; ++c) {
+    if (tets[c].empty()) continue;
+    // The piece as its own tet mesh (compact node numbering).
+    std::vector<int> nodes;
+    cutting::TetMesh piece;
+    piece.T.resize(static_cast<Eigen::Index>(tets[c].size()), 4);
+    piece.material.resize(static_cast<Eigen::Index>(tets[c].size()));
+    ChipShape chip;
+    for (size_t k = 0; k < tets[c].size(); ++k) {
+      const int t = tets[c][k];
+      for (int j = 0; j < 4; ++j) {
+        const int node = after.T(t, j);
+        if (local[node] < 0) {
+          local[node] = static_cast<int>(nodes.size());
+          nodes.push_back(node);
+        }
+        piece.T(static_cast<Eigen::Index>(k), j) = local[node];
+      }
+      piece.material[static_cast<Eigen::Index>(k)] = after.material[t];
+      double density = 1.05e-3;
+      for (const sim::Material& m : materials) {
+        if (m.label == after.material[t]) density = m.density_g_mm3;
+      }
+      const double vol = std::abs(cutting::tetVolume(after, t));
+      Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+      for (int j = 0; j < 4; ++j) centroid += 0.25 * after.X.row(after.T(t, j)).transpose();
+      chip.volume_mm3 += vol;
+      chip.mass_g += density * vol;
+      chip.centre += density * vol * centroid;
+    }
+    if (chip.mass_g > 0.0) chip.centre /= chip.mass_g;
+    piece.X.resize(static_cast<Eigen::Index>(nodes.size()), 3);
+    for (size_t i = 0; i < nodes.size(); ++i) {
+      piece.X.row(static_cast<Eigen::Index>(i)) = after.X.row(nodes[i]);
+      chip.velocity += v.row(nodes[i]).transpose() / static_cast<double>(nodes.size());
+    }
+    // Its boundary, with the surface vertices numbered compactly.
+    Eigen::VectorXi face_tet;
+    const cutting::Tris faces = cutting::boundaryFaces(piece, &face_tet);
+    std::vector<int> vertex(nodes.size(), -1);
+    std::vector<int> surface;  // piece node of each surface vertex
+    chip.triangles.resize(faces.rows(), 3);
+    for (Eigen::Index f = 0; f < faces.rows(); ++f) {
+      for (int j = 0; j < 3; ++j) {
+        const int p = faces(f, j);
+        if (vertex[p] < 0) {
+          vertex[p] = static_cast<int>(surface.size());
+          surface.push_back(p);
+          chip.material.push_back(render::SurfaceMaterial::Myoma);
+        }
+        chip.triangles(f, j) = vertex[p];
+        if (piece.material[face_tet[f]] != myoma_label) chip.material[vertex[p]] = render::SurfaceMaterial::Endometrium;
+      }
+    }
+    chip.vertices.resize(static_cast<Eigen::Index>(surface.size()), 3);
+    for (size_t i = 0; i < surface.size(); ++i) {
+      const int node = nodes[surface[i]];
+      chip.vertices.row(static_cast<Eigen::Index>(i)) = piece.X.row(surface[i]);
+      if (node < static_cast<int>(on_cut.size()) && on_cut[node]) chip.material[i] = render::SurfaceMaterial::Cut;
+    }
+    for (int node : nodes) local[node] = -1;
+    out.push_back(std::move(chip));
+  }
+  return out;
+}
+
 }  // namespace
 
 Result<render::SurfaceMesh> loadSurface(const std::string& path, render::SurfaceMaterial material) {
@@ -128,6 +206,7 @@ Status Simulation::setTopology(cutting::TetMesh rest_mesh, const sim::NodeVector
   // the loop moves less than that, a step only moves the vertices (see collision.hpp).
   if (Status st = collision_.build(surface_faces_, state_.x, 0.5); !st.ok()) return st;
   locator_.build(mesh_, state_.x);
+  if (chips_) chips_->setCavity(state_.x, surface_faces_);
   ++topology_version_;
   return Status::Ok();
 }
@@ -151,6 +230,14 @@ Result<std::unique_ptr<Simulation>> Simulation::create(const Scene& scene) {
   s->previous_wire_ = s->wire_;
   s->swept_wire_.reset(static_cast<int>(s->wire_.rows()));
   s->sweep_.reserve(10000, static_cast<int>(s->wire_.rows()));  // a 10 s pass without allocating
+  if (scene.chips.mode == ChipSettings::Mode::Simulate) {
+    ChipToolGeometry tool;
+    tool.shaft_radius_mm = scene.contact.shaft_radius_mm;
+    tool.shaft_length_mm = scene.contact.shaft_length_mm;
+    tool.loop = s->loop_;
+    s->chips_ = std::make_unique<ChipWorld>(scene.chips, scene.sim.gravity, scene.sim.dt, tool);
+    s->chips_->moveTool(s->pose_);
+  }
   if (Status st = s->setTopology(s->mesh_, nullptr, nullptr); !st.ok()) return Error{scene.path + ": " + st.error()};
   // The serosa of the initial mesh; exact distances are needed up to margin + wire radius.
   s->outer_wall_.build(s->mesh_, s->model_.fixed, scene.safety.perforation_margin_mm + s->loop_.wire_radius_mm);
@@ -223,6 +310,15 @@ void Simulation::step() {
   input.external_force = &contact_force_;
   sim::step(model_, state_, input);
   device_->commandForce(tool_force_n_);  // clamped and NaN-guarded by the device
+  if (chips_) {
+    chips_->moveTool(pose_);
+    if (chips_->numChips() > 0) {
+      const auto t0 = std::chrono::steady_clock::now();  // measurement only
+      chips_->step();
+      chip_step_s_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      ++chip_steps_;
+    }
+  }
 
   // Shaving: entry is the first contact of the active loop with the tissue (its sweep over
   // this step touches the surface, or it is buried); the sweep grows while it touches; on
@@ -415,7 +511,10 @@ void Simulation::finishPass() {
     if (j >= 0 && j < n) old_to_kept[i] = new_index[j];
   }
   outer_wall_.remapNodes(old_to_kept);
+  std::vector<ChipShape> chip_shapes;
+  if (chips_) chip_shapes = chipShapes(after, v, comps, on_cut, scene_.materials, myoma_label);
   if (Status st = setTopology(std::move(rest_mesh), &x_kept, &v_kept); !st.ok()) return fail(st.error());
+  for (const ChipShape& chip : chip_shapes) chips_->addChip(chip);  // after the cavity is rebuilt
   const cutting::MeshStats stats = cutting::computeStats(mesh_);
   rec.elements = mesh_.numTets();
   rec.nodes = mesh_.numNodes();
@@ -458,6 +557,23 @@ void Simulation::fillSnapshot(render::RenderSnapshot& snap) const {
   snap.camera.lens_deg = static_cast<float>(scene_.camera.lens_deg);
   snap.camera.fov_deg = static_cast<float>(scene_.camera.fov_deg);
   snap.camera.light_intensity = static_cast<float>(scene_.camera.light);
+  if (chips_) {
+    const std::vector<ChipBody>& chips = chips_->chips();
+    if (snap.chips_version != chips_->version() || snap.chips.size() != chips.size()) {
+      snap.chips.resize(chips.size());
+      for (size_t i = 0; i < chips.size(); ++i) snap.chips[i].surface = chips[i].surface;
+      snap.chips_version = chips_->version();
+    }
+    for (size_t i = 0; i < chips.size(); ++i) {
+      render::Pose& pose = snap.chips[i].pose;
+      for (int r = 0; r < 3; ++r) {
+        pose.position[r] = static_cast<float>(chips[i].position[r]);
+        for (int c = 0; c < 3; ++c) pose.rotation[3 * c + r] = static_cast<float>(chips[i].rotation(r, c));
+      }
+    }
+  } else if (!snap.chips.empty()) {
+    snap.chips.clear();
+  }
   snap.step = state_.steps;
   snap.time_s = state_.time;
 }

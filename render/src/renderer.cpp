@@ -256,7 +256,8 @@ CameraMatrices cameraMatrices(const Camera& camera, int width, int height) {
 
 Renderer::Renderer(int width, int height, const RendererOptions& options)
     : width_(width), height_(height), options_(options),
-      tissue_(std::make_unique<MeshBuffers>()), tool_(std::make_unique<MeshBuffers>()) {}
+      tissue_(std::make_unique<MeshBuffers>()), tool_(std::make_unique<MeshBuffers>()),
+      chips_(std::make_unique<MeshBuffers>()) {}
 
 hysim::Result<std::unique_ptr<Renderer>> Renderer::create(int width, int height,
                                                           const RendererOptions& options) {
@@ -387,7 +388,7 @@ hysim::Status Renderer::init() {
   glBindFramebuffer(GL_FRAMEBUFFER, 0);
 
   // Vertex arrays: layout fixed once, buffers refilled every frame.
-  for (MeshBuffers* b : {tissue_.get(), tool_.get()}) {
+  for (MeshBuffers* b : {tissue_.get(), tool_.get(), chips_.get()}) {
     glGenVertexArrays(1, &b->vao);
     glGenBuffers(1, &b->vbo);
     glGenBuffers(1, &b->ibo);
@@ -421,7 +422,7 @@ hysim::Status Renderer::init() {
 
 Renderer::~Renderer() {
   // GL objects need the context; callers keep it current (OffscreenRenderer does).
-  for (MeshBuffers* b : {tissue_.get(), tool_.get()}) {
+  for (MeshBuffers* b : {tissue_.get(), tool_.get(), chips_.get()}) {
     if (b == nullptr) continue;
     if (b->vao) glDeleteVertexArrays(1, &b->vao);
     if (b->vbo) glDeleteBuffers(1, &b->vbo);
@@ -581,6 +582,32 @@ void Renderer::draw(const RenderSnapshot& snapshot) {
                                          pose.position[1], pose.position[2], 1};
     upload(snapshot.tool, SurfaceMaterial::Tool, *tool_);
     drawMesh(*tool_, model, normalMatrix(r));
+  }
+  // Chips: each body-frame surface moved by its pose, all into one world-frame mesh (one
+  // upload and one draw call for up to a few dozen small meshes).
+  if (!snapshot.chips.empty()) {
+    SurfaceMesh& w = chips_world_;
+    w.positions.clear();
+    w.triangles.clear();
+    w.material.clear();
+    for (const Chip& chip : snapshot.chips) {
+      const std::size_t nv = chip.surface.positions.size() / 3;
+      const auto base = static_cast<std::uint32_t>(w.positions.size() / 3);
+      const auto& r = chip.pose.rotation;
+      const auto& t = chip.pose.position;
+      for (std::size_t v = 0; v < nv; ++v) {
+        const float* p = &chip.surface.positions[3 * v];
+        for (int k = 0; k < 3; ++k) w.positions.push_back(r[k] * p[0] + r[3 + k] * p[1] + r[6 + k] * p[2] + t[k]);
+      }
+      for (std::uint32_t i : chip.surface.triangles) {
+        w.triangles.push_back(i < nv ? base + i : 0xffffffffu);  // bad indices stay bad
+      }
+      for (std::size_t v = 0; v < nv; ++v) {
+        w.material.push_back(v < chip.surface.material.size() ? chip.surface.material[v] : SurfaceMaterial::Cut);
+      }
+    }
+    upload(w, SurfaceMaterial::Cut, *chips_);
+    drawMesh(*chips_, kIdentity4, kIdentity3);
   }
   upload(snapshot.tissue, SurfaceMaterial::Endometrium, *tissue_);
   drawMesh(*tissue_, kIdentity4, kIdentity3);

@@ -270,6 +270,53 @@ TEST_F(RenderTest, DeterministicAndFollowsDeformation) {
   EXPECT_EQ(first.rgba, again.rgba);
 }
 
+// A cube chip (side a) in its body frame: 8 corners, 12 triangles.
+hr::Chip cubeChip(float a, hr::SurfaceMaterial material) {
+  hr::Chip chip;
+  for (int k = 0; k < 8; ++k) {
+    chip.surface.positions.insert(chip.surface.positions.end(),
+                                  {(k & 1 ? 0.5f : -0.5f) * a, (k & 2 ? 0.5f : -0.5f) * a, (k & 4 ? 0.5f : -0.5f) * a});
+    chip.surface.material.push_back(material);
+  }
+  chip.surface.triangles = {0, 2, 1, 1, 2, 3, 4, 5, 6, 5, 7, 6, 0, 1, 4, 1, 5, 4,
+                            2, 6, 3, 3, 6, 7, 0, 4, 2, 2, 4, 6, 1, 3, 5, 3, 7, 5};
+  return chip;
+}
+
+TEST_F(RenderTest, ChipsAreDrawnAtTheirPose) {
+  GET_RENDERER_OR_SKIP(r, 320, 240);
+  hr::RenderSnapshot s = hr::makeDemoSnapshot({.target_triangles = 2000, .with_tool = false});
+  const hr::Image without = r->render(s);
+  const std::size_t tissue_triangles = r->renderer().lastTriangleCount();
+  // A 3 mm chip 10 mm ahead of the camera along its view direction.
+  const hr::CameraMatrices cm = hr::cameraMatrices(s.camera, 320, 240);
+  hr::Chip chip = cubeChip(3.0f, hr::SurfaceMaterial::Cut);
+  for (int k = 0; k < 3; ++k) chip.pose.position[k] = s.camera.tip[k] + 10.0f * cm.view_dir[k];
+  s.chips.push_back(chip);
+  const hr::Image with_chip = r->render(s);
+  EXPECT_EQ(r->renderer().lastTriangleCount(), tissue_triangles + 12);
+  auto d = hr::compareImages(without, with_chip, 24);
+  ASSERT_TRUE(d.ok());
+  EXPECT_GT(d->fraction_over, 0.01);
+  EXPECT_LT(d->fraction_over, 0.5);
+  // Moved 2 mm along the image's up direction: drawn elsewhere.
+  for (int k = 0; k < 3; ++k) s.chips[0].pose.position[k] += 2.0f * cm.image_up[k];
+  const hr::Image moved = r->render(s);
+  d = hr::compareImages(with_chip, moved, 24);
+  ASSERT_TRUE(d.ok());
+  EXPECT_GT(d->fraction_over, 0.002);
+  // No chips again: the same frame as before (the chip buffers do not linger).
+  s.chips.clear();
+  EXPECT_EQ(r->render(s).rgba, without.rgba);
+  // A chip with bad indices and no materials: its bad triangles are dropped, no crash.
+  hr::Chip bad = cubeChip(3.0f, hr::SurfaceMaterial::Myoma);
+  bad.surface.triangles.insert(bad.surface.triangles.end(), {0u, 1u, 99u});
+  bad.surface.material.clear();
+  s.chips.push_back(bad);
+  (void)r->render(s);
+  EXPECT_EQ(r->renderer().lastTriangleCount(), tissue_triangles + 12);
+}
+
 TEST_F(RenderTest, BadInputDoesNotCrash) {
   GET_RENDERER_OR_SKIP(r, 160, 120);
   hr::RenderSnapshot s = hr::makeDemoSnapshot({.target_triangles = 500, .with_tool = true});

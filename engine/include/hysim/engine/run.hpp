@@ -40,6 +40,11 @@ struct RunReport {
   int perforations = 0;                            // events (see PerforationEvent)
   std::vector<PerforationEvent> perforation_events;  // the first Simulation::kMaxPerforationEvents
   int serosa_faces = 0;                            // outer-surface faces the check measures against
+  // Chips (scene `chips`): mode, simulated chips in the cavity at the end, chips that left
+  // it, chips dropped over the cap, and the mean wall time of a chip step (Bullet), us.
+  std::string chips_mode = "remove";
+  int chips_in_cavity = 0, chips_left_cavity = 0, chips_over_cap = 0;
+  double chip_step_us_mean = 0.0;
 };
 
 // Numbers a trainee or instructor reads after a run (also in the JSON report).

@@ -50,6 +50,18 @@ struct RenderSettings {
   int every = 50;  // render a frame every k steps
 };
 
+// Free pieces of tissue a cut sets loose (not connected to anchored tissue). Either way their
+// volume counts as resected; `Simulate` also keeps them as rigid bodies in the cavity.
+struct ChipSettings {
+  enum class Mode { Remove, Simulate };
+  Mode mode = Mode::Remove;
+  int max_chips = 16;                 // simulated at once; the oldest goes beyond this
+  double drag_per_s = 10.0;           // linear velocity decays as exp(-drag t) (distension fluid)
+  double angular_drag_per_s = 20.0;   // same for the angular velocity
+  double fluid_density_g_cm3 = 1.0;   // buoyancy: a chip sinks with g (1 - rho_fluid / rho_chip)
+  double friction = 0.8;              // Coulomb friction coefficient on the wall and the tool
+};
+
 struct Scene {
   std::string path;        // the scene file
   std::string name;
@@ -65,6 +77,7 @@ struct Scene {
   SafetySettings safety;
   CameraSettings camera;
   RenderSettings render;
+  ChipSettings chips;
 };
 
 // Parses and checks a scene file. Does not load the meshes (see Simulation::create).

@@ -9,6 +9,7 @@
 #include "hysim/cutting/mesh.hpp"
 #include "hysim/engine/collision.hpp"
 #include "hysim/engine/outer_wall.hpp"
+#include "hysim/engine/chips.hpp"
 #include "hysim/engine/scene.hpp"
 #include "hysim/engine/tet_locator.hpp"
 #include "hysim/engine/tool.hpp"
@@ -73,7 +74,13 @@ class Simulation {
   int numSurfaceNodes() const { return static_cast<int>(surface_nodes_.size()); }
   // Reaction force on the tool from tissue contact in the last step, newtons.
   const Eigen::Vector3d& toolForceN() const { return tool_force_n_; }
-  std::uint64_t stateHash() const { return sim::stateHash(state_); }
+  // Positions and velocities of the tissue, and the simulated chips' poses (when there are any).
+  std::uint64_t stateHash() const { return chips_ ? chips_->hash(sim::stateHash(state_)) : sim::stateHash(state_); }
+  // The simulated chips (scene `chips: simulate`); null when chips are removed.
+  const ChipWorld* chips() const { return chips_.get(); }
+  // Wall time spent stepping the chips (Bullet), seconds, and the steps that had chips.
+  double chipStepSeconds() const { return chip_step_s_; }
+  long chipSteps() const { return chip_steps_; }
   const std::vector<PassRecord>& passes() const { return passes_; }
   bool loopInTissue() const { return loop_in_tissue_; }
   const LoopGeometry& loop() const { return loop_; }
@@ -149,6 +156,10 @@ class Simulation {
   int perforation_count_ = 0;
   bool perforating_ = false;
   double serosa_clearance_mm_ = 0.0;
+  // Chips (simulate mode).
+  std::unique_ptr<ChipWorld> chips_;
+  double chip_step_s_ = 0.0;
+  long chip_steps_ = 0;
 };
 
 // Loads a surface (OBJ, STL, PLY, glTF...) with assimp, triangulated, in millimetres.

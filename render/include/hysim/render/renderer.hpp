@@ -92,6 +92,8 @@ class Renderer {
   unsigned resolve_fbo_ = 0, resolve_color_ = 0, resolve_depth_ = 0;
   std::unique_ptr<MeshBuffers> tissue_;
   std::unique_ptr<MeshBuffers> tool_;
+  std::unique_ptr<MeshBuffers> chips_;
+  SurfaceMesh chips_world_;  // all chips in world coordinates (scratch, reused every frame)
 
   // Uniform locations.
   int u_view_proj_ = -1, u_model_ = -1, u_normal_matrix_ = -1, u_palette_ = -1, u_eye_ = -1,

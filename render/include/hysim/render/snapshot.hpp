@@ -45,12 +45,21 @@ struct Camera {
   float light_intensity = 1.0f;   // tip light, 1 = nominal; falls off with distance squared
 };
 
+// A free piece of tissue (a chip) moving as a rigid body: its surface in its body frame
+// and its pose.
+struct Chip {
+  SurfaceMesh surface;  // body frame
+  Pose pose;            // body -> world
+};
+
 struct RenderSnapshot {
   SurfaceMesh tissue;              // deformable tissue surface (and static cavity, if any)
   SurfaceMesh tool;                // tool surface in the tool's body frame
   Pose tool_pose;                  // body -> world
   bool tool_visible = false;
   Camera camera;
+  std::vector<Chip> chips;         // simulated chips (empty when chips are removed)
+  int chips_version = -1;          // changes when chips are added or removed
   std::uint64_t step = 0;          // simulation step this snapshot was taken at
   int topology_version = -1;       // changes when the tissue's triangles change (a cut)
   double time_s = 0.0;
