@@ -126,6 +126,7 @@ Status Simulation::setTopology(cutting::TetMesh rest_mesh, const sim::NodeVector
   // The boundary's hierarchy, with boxes grown by half a millimetre: while the tissue near
   // the loop moves less than that, a step only moves the vertices (see collision.hpp).
   if (Status st = collision_.build(surface_faces_, state_.x, 0.5); !st.ok()) return st;
+  collision_active_ = true;  // just fitted
   locator_.build(mesh_, state_.x);
   ++topology_version_;
   return Status::Ok();
@@ -198,7 +199,14 @@ void Simulation::computeContact() {
 }
 
 bool Simulation::loopTouchesTissue() {
-  collision_.update(state_.x);
+  // Refitted when the electrode becomes active (or after a topology change), then followed:
+  // only vertices that moved further than the margin get their boxes refitted.
+  if (!collision_active_) {
+    collision_.refit(state_.x);
+    collision_active_ = true;
+  } else {
+    collision_.update(state_.x);
+  }
   swept_wire_.update(previous_wire_, wire_);
   if (collision_.touches(swept_wire_, loop_.wire_radius_mm)) return true;
   // The sweep meets no boundary face: the wire (connected, part of the sweep) is wholly
@@ -227,6 +235,7 @@ void Simulation::step() {
   loopPoints(loop_, pose_, wire_);
   if (!pose_.pedal && !cutting_) {
     loop_in_tissue_ = false;
+    collision_active_ = false;
     return;
   }
   loop_in_tissue_ = pose_.pedal && loopTouchesTissue();

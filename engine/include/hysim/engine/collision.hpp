@@ -73,16 +73,19 @@ class TissueCollision {
   // Moves the hierarchy's vertices to x (same mesh) and refits the boxes bottom-up in place,
   // keeping the tree. Allocates nothing.
   void refit(const sim::NodeVectors& x);
-  // Moves the vertices to x and refits only if a vertex has moved further than the margin
-  // since the last refit (O(#V) check; a margin of 0 refits every time). Returns whether it
-  // refitted. Allocates nothing.
+  // Moves the vertices to x; a vertex that has moved further than the margin since its boxes
+  // were fitted gets the leaf boxes of its triangles refitted and their ancestors grown (a
+  // local refit, O(#V) check plus O(depth) per moved vertex; boxes only grow until the next
+  // refit()). A margin of 0 refits everything every time. Returns whether a box changed.
+  // Allocates nothing.
   bool update(const sim::NodeVectors& x);
   // Does the swept wire, thickened by `radius`, touch a triangle? Allocates nothing.
   bool touches(const SweptWire& sweep, double radius) const;
   int numFaces() const;
   int numVertices() const;  // distinct nodes of the faces
   double margin() const;
-  long numRefits() const;   // since construction (build included)
+  long numRefits() const;       // full refits since construction (build included)
+  long numLocalRefits() const;  // vertices refitted locally by update()
 
  private:
   struct Impl;

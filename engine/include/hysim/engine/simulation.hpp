@@ -111,6 +111,7 @@ class Simulation {
   LoopGeometry loop_;
   TissueCollision collision_;  // boundary faces, refitted only while the electrode is active
   SweptWire swept_wire_;       // the wire's motion in the last step
+  bool collision_active_ = false;  // the hierarchy was refitted and is followed step by step
   TetLocator locator_;
   Eigen::Matrix<double, Eigen::Dynamic, 3> wire_, previous_wire_;
   Sweep sweep_;
