@@ -76,8 +76,25 @@ struct TissueCollision::Impl {
   int num_faces = 0;
   bool children_after_parents = false;  // FCL's build order, checked once per build
   double margin = 0.0;                  // mm, leaf boxes are grown by this
-  std::vector<fcl::Vector3d> refit_x;   // #V vertex positions at the last refit
+  std::vector<fcl::Vector3d> refit_x;   // #V vertex positions the boxes were fitted around
   long refits = 0;
+  long local_refits = 0;
+  // For local refits: parent of each box (-1 at the root), the leaf box of each triangle, and
+  // the triangles of each vertex (CSR).
+  std::vector<int> parent;       // #BV
+  std::vector<int> leaf_of_tri;  // #F
+  std::vector<int> vtx_start;    // #V + 1
+  std::vector<int> vtx_tris;     // 3 #F
+
+  // Leaf box of triangle `tri`: its vertices' refit_x positions grown by the margin, so it
+  // holds every vertex that stays within the margin of where it was fitted.
+  void fitLeaf(fcl::AABBd& box, int tri) const {
+    const fcl::Triangle& t = bvh->tri_indices[tri];
+    const fcl::Vector3d &p = refit_x[t[0]], &q = refit_x[t[1]], &r = refit_x[t[2]];
+    const fcl::Vector3d grow = fcl::Vector3d::Constant(margin);
+    box.min_ = p.cwiseMin(q).cwiseMin(r) - grow;
+    box.max_ = p.cwiseMax(q).cwiseMax(r) + grow;
+  }
 };
 
 TissueCollision::TissueCollision() : impl_(std::make_unique<Impl>()) {}
@@ -89,6 +106,7 @@ int TissueCollision::numFaces() const { return impl_->num_faces; }
 int TissueCollision::numVertices() const { return static_cast<int>(impl_->nodes.size()); }
 double TissueCollision::margin() const { return impl_->margin; }
 long TissueCollision::numRefits() const { return impl_->refits; }
+long TissueCollision::numLocalRefits() const { return impl_->local_refits; }
 
 cutting::Tris allTetFaces(const cutting::TetMesh& mesh) {
   std::vector<std::array<int, 3>> faces;
@@ -147,6 +165,26 @@ Status TissueCollision::build(const cutting::Tris& faces, const sim::NodeVectors
       impl_->children_after_parents = false;
     }
   }
+  Impl& m = *impl_;
+  m.parent.assign(static_cast<size_t>(bvh->getNumBVs()), -1);
+  m.leaf_of_tri.assign(triangles.size(), -1);
+  for (int b = 0; b < bvh->getNumBVs(); ++b) {
+    const fcl::BVNode<fcl::AABBd>& n = bvh->getBV(b);
+    if (n.isLeaf()) {
+      m.leaf_of_tri[static_cast<size_t>(n.primitiveId())] = b;
+    } else if (m.children_after_parents) {
+      m.parent[static_cast<size_t>(n.leftChild())] = b;
+      m.parent[static_cast<size_t>(n.rightChild())] = b;
+    }
+  }
+  m.vtx_start.assign(m.nodes.size() + 1, 0);
+  for (const fcl::Triangle& t : triangles)
+    for (int c = 0; c < 3; ++c) ++m.vtx_start[t[c] + 1];
+  for (size_t i = 0; i < m.nodes.size(); ++i) m.vtx_start[i + 1] += m.vtx_start[i];
+  m.vtx_tris.assign(3 * triangles.size(), -1);
+  std::vector<int> fill(m.vtx_start.begin(), m.vtx_start.end() - 1);
+  for (size_t f = 0; f < triangles.size(); ++f)
+    for (int c = 0; c < 3; ++c) m.vtx_tris[static_cast<size_t>(fill[triangles[f][c]]++)] = static_cast<int>(f);
   impl_->bvh = std::move(bvh);
   impl_->num_faces = static_cast<int>(triangles.size());
   impl_->refit_x = std::move(vertices);
@@ -173,15 +211,10 @@ void TissueCollision::refit(const sim::NodeVectors& x) {
   // The same bottom-up refit as FCL's endReplaceModel(true, true), as one loop (FCL numbers
   // a node's children after it, so a backward sweep sees children first; checked by build()),
   // with the leaf boxes grown by the margin.
-  const fcl::Vector3d grow = fcl::Vector3d::Constant(m.margin);
-  const fcl::Triangle* tris = bvh->tri_indices;
   for (int b = bvh->getNumBVs() - 1; b >= 0; --b) {
     fcl::BVNode<fcl::AABBd>& n = bvh->getBV(b);
     if (n.isLeaf()) {
-      const fcl::Triangle& t = tris[n.primitiveId()];
-      const fcl::Vector3d &p = v[t[0]], &q = v[t[1]], &r = v[t[2]];
-      n.bv.min_ = p.cwiseMin(q).cwiseMin(r) - grow;
-      n.bv.max_ = p.cwiseMax(q).cwiseMax(r) + grow;
+      m.fitLeaf(n.bv, n.primitiveId());
     } else {
       const fcl::AABBd& a = bvh->getBV(n.leftChild()).bv;
       const fcl::AABBd& c = bvh->getBV(n.rightChild()).bv;
@@ -199,17 +232,32 @@ bool TissueCollision::update(const sim::NodeVectors& x) {
     refit(x);
     return true;
   }
-  // The narrow phase reads the vertices, so they always move; the boxes only when a vertex
-  // has left its margin since the last refit.
+  // The narrow phase reads the vertices, so they always move. A vertex that has left its
+  // margin is fitted anew where it is now: the leaves of its triangles are refitted and
+  // their ancestors grown to hold them (up to the first that already does). Ancestors only
+  // grow, so they stay valid; refit() tightens them again.
   fcl::Vector3d* v = bvh->vertices;
   const double limit = m.margin * m.margin;
-  bool stale = false;
+  bool moved = false;
   for (size_t i = 0; i < m.nodes.size(); ++i) {
     v[i] = x.row(m.nodes[i]).transpose();
-    stale = stale || (v[i] - m.refit_x[i]).squaredNorm() > limit;
+    if ((v[i] - m.refit_x[i]).squaredNorm() <= limit) continue;
+    moved = true;
+    ++m.local_refits;
+    m.refit_x[i] = v[i];
+    for (int k = m.vtx_start[i]; k < m.vtx_start[i + 1]; ++k) {
+      const int leaf = m.leaf_of_tri[static_cast<size_t>(m.vtx_tris[static_cast<size_t>(k)])];
+      fcl::AABBd& box = bvh->getBV(leaf).bv;
+      m.fitLeaf(box, m.vtx_tris[static_cast<size_t>(k)]);
+      for (int p = m.parent[static_cast<size_t>(leaf)]; p >= 0; p = m.parent[static_cast<size_t>(p)]) {
+        fcl::AABBd& up = bvh->getBV(p).bv;
+        if (up.contain(box)) break;
+        up.min_ = up.min_.cwiseMin(box.min_);
+        up.max_ = up.max_.cwiseMax(box.max_);
+      }
+    }
   }
-  if (stale) refit(x);
-  return stale;
+  return moved;
 }
 
 bool TissueCollision::touches(const SweptWire& sweep, double radius) const {

@@ -205,6 +205,8 @@ Status Simulation::setTopology(cutting::TetMesh rest_mesh, const sim::NodeVector
   // The boundary's hierarchy, with boxes grown by half a millimetre: while the tissue near
   // the loop moves less than that, a step only moves the vertices (see collision.hpp).
   if (Status st = collision_.build(surface_faces_, state_.x, 0.5); !st.ok()) return st;
+  collision_active_ = true;  // just fitted
+  buried_known_ = false;
   locator_.build(mesh_, state_.x);
   if (chips_) chips_->setCavity(state_.x, surface_faces_);
   ++topology_version_;
@@ -290,13 +292,28 @@ void Simulation::computeContact() {
 }
 
 bool Simulation::loopTouchesTissue() {
-  collision_.update(state_.x);
+  // Refitted when the electrode becomes active (or after a topology change), then followed:
+  // only vertices that moved further than the margin get their boxes refitted.
+  if (!collision_active_) {
+    collision_.refit(state_.x);
+    collision_active_ = true;
+  } else {
+    collision_.update(state_.x);
+  }
   swept_wire_.update(previous_wire_, wire_);
-  if (collision_.touches(swept_wire_, loop_.wire_radius_mm)) return true;
+  if (collision_.touches(swept_wire_, loop_.wire_radius_mm)) {
+    buried_known_ = false;
+    return true;
+  }
   // The sweep meets no boundary face: the wire (connected, part of the sweep) is wholly
-  // inside or wholly outside the tissue, and one of its points tells which.
-  if (locator_.maxDisplacement(state_.x) > locator_.margin()) locator_.build(mesh_, state_.x);
-  return locator_.locate(mesh_, state_.x, wire_.row(wire_.rows() / 2).transpose()) >= 0;
+  // inside or wholly outside the tissue, and one of its points tells which. It stays on that
+  // side until the next contact, so the test runs once per contact-free stretch.
+  if (!buried_known_) {
+    if (locator_.maxDisplacement(state_.x) > locator_.margin()) locator_.build(mesh_, state_.x);
+    buried_ = locator_.locate(mesh_, state_.x, wire_.row(wire_.rows() / 2).transpose()) >= 0;
+    buried_known_ = true;
+  }
+  return buried_;
 }
 
 void Simulation::step() {
@@ -333,6 +350,8 @@ void Simulation::step() {
   }
   if (!pose_.pedal && !cutting_) {
     loop_in_tissue_ = false;
+    collision_active_ = false;
+    buried_known_ = false;
     return;
   }
   loop_in_tissue_ = pose_.pedal && loopTouchesTissue();

@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <random>
 
 #include "alloc_counter.hpp"
 #include "box_mesh.hpp"
@@ -187,11 +188,73 @@ TEST(Collision, RefitFollowsTheDeformation) {
   EXPECT_FALSE(collision.touches(sweep, loop.wire_radius_mm));
 }
 
+// update() with a margin: boxes are refitted only around vertices that left their margin,
+// and queries stay exact in between (the narrow phase reads the moved vertices).
+TEST(Collision, UpdateWithAMarginStaysExact) {
+  const cutting::TetMesh mesh = slab();
+  sim::NodeVectors x = mesh.X;
+  TissueCollision collision;
+  ASSERT_TRUE(collision.build(cutting::boundaryFaces(mesh), x, 0.5).ok());
+  LoopGeometry loop;
+  SweptWire sweep;
+  sweep.reset(loop.segments + 1);
+  const WirePoints wire = wireAt(loop, 6.0);  // 2 mm above the slab
+  sweep.update(wire, wire);
+  auto rise = [&](double dz) {
+    x = mesh.X;
+    x.col(2).array() += dz;
+    collision.update(x);
+    return collision.touches(sweep, loop.wire_radius_mm);
+  };
+  EXPECT_FALSE(rise(0.4));  // within the margin: no box changes
+  EXPECT_EQ(collision.numLocalRefits(), 0);
+  EXPECT_TRUE(rise(1.9));   // 0.1 mm below the wire
+  EXPECT_EQ(collision.numLocalRefits(), collision.numVertices());
+  EXPECT_FALSE(rise(2.3));  // wire 0.3 mm inside: no surface within 0.15 mm
+  EXPECT_FALSE(rise(1.5));
+  EXPECT_TRUE(rise(1.88));
+  EXPECT_EQ(collision.numLocalRefits(), collision.numVertices());  // all within the margin since
+}
+
+// Random jitter of every vertex (a random walk, steps up to 0.4 mm): update() answers as a
+// hierarchy built from scratch does.
+TEST(Collision, UpdateAgreesWithAFreshHierarchy) {
+  const cutting::TetMesh mesh = slab();
+  const cutting::Tris faces = cutting::boundaryFaces(mesh);
+  sim::NodeVectors x = mesh.X;
+  TissueCollision followed;
+  ASSERT_TRUE(followed.build(faces, x, 0.5).ok());
+  LoopGeometry loop;
+  SweptWire sweep;
+  sweep.reset(loop.segments + 1);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> step(-0.4, 0.4);
+  int agreed = 0, touched = 0;
+  for (int k = 0; k < 60; ++k) {
+    for (Eigen::Index i = 0; i < x.rows(); ++i)
+      for (int c = 0; c < 3; ++c) x(i, c) += step(rng);
+    followed.update(x);
+    TissueCollision fresh;
+    ASSERT_TRUE(fresh.build(faces, x).ok());
+    for (double z : {3.0, 3.6, 4.0, 4.4, 5.0, 6.0}) {
+      const WirePoints a = wireAt(loop, z), b = wireAt(loop, z - 0.1);
+      sweep.update(a, b);
+      const bool expected = fresh.touches(sweep, loop.wire_radius_mm);
+      agreed += followed.touches(sweep, loop.wire_radius_mm) == expected ? 1 : 0;
+      touched += expected ? 1 : 0;
+    }
+  }
+  EXPECT_EQ(agreed, 60 * 6);
+  EXPECT_GT(touched, 30);
+  EXPECT_GT(followed.numLocalRefits(), 0);
+  EXPECT_EQ(followed.numRefits(), 1);  // the build's
+}
+
 TEST(Collision, RefitUpdateAndQueryAllocateNothing) {
   const cutting::TetMesh mesh = slab();
   sim::NodeVectors x = mesh.X;
   TissueCollision collision;
-  ASSERT_TRUE(collision.build(cutting::boundaryFaces(mesh), x).ok());
+  ASSERT_TRUE(collision.build(cutting::boundaryFaces(mesh), x, 0.5).ok());
   LoopGeometry loop;
   SweptWire sweep;
   sweep.reset(loop.segments + 1);
@@ -201,8 +264,9 @@ TEST(Collision, RefitUpdateAndQueryAllocateNothing) {
   {
     testing::AllocationCounter counter;
     for (int i = 0; i < 10; ++i) {
-      x(0, 2) += 1e-3;
+      x(0, 2) += 0.3;  // leaves the margin every other step
       collision.refit(x);
+      collision.update(x);
       sweep.update(a, b);
       touching += collision.touches(sweep, loop.wire_radius_mm) ? 1 : 0;
     }

@@ -112,6 +112,7 @@ TEST(Shaving, NoCutWhileThePedalIsOff) {
   EXPECT_EQ((*sim)->mesh().numTets(), elements);
   // The inactive loop costs no collision work: the hierarchy was never touched.
   EXPECT_EQ((*sim)->collision().numRefits(), refits);
+  EXPECT_EQ((*sim)->collision().numLocalRefits(), 0);
 }
 
 // Entry is the first contact of the active loop's sweep with the slab's end face (x = 15),

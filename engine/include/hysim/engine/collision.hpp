@@ -3,28 +3,43 @@
 // tissue's surface.
 //
 // SweptWire is that volume: per wire segment the quad between its previous and current
-// positions (2 triangles), a small FCL hierarchy whose vertices are replaced and whose
-// boxes are refitted in place every step. TissueCollision holds an AABB hierarchy of the
-// tissue's boundary triangles, refitted in place (same tree) while the electrode is active
-// and rebuilt after a topology change. touches() is an FCL mesh-mesh distance traversal that
-// stops at the first pair of triangles closer than the wire radius (that is the thickening).
+// positions (2 triangles), a small FCL hierarchy whose vertices are replaced and whose boxes
+// are refitted in place every step. TissueCollision holds an AABB hierarchy of the tissue's
+// boundary triangles only, built after every topology change, refitted in place (same tree)
+// when the electrode becomes active and then followed step by step: leaf boxes are grown by
+// a margin, and only the leaves of vertices that moved further than that are refitted (with
+// their ancestors grown). touches() is an FCL mesh-mesh distance traversal that stops at the
+// first pair of triangles closer than the wire radius (that is the thickening). Nothing of
+// this runs while the pedal is up and no pass is open.
 //
 // The boundary is enough: if the swept volume meets no boundary triangle, the wire lies
 // wholly inside or wholly outside the tissue (a connected set that crosses no surface), so one
-// point-in-tissue test (TetLocator) settles the "buried loop" case.
+// point-in-tissue test (TetLocator) settles the "buried loop" case. Every tet face (interior
+// ones too) would make that test unnecessary but costs ~8x in refit and ~10x in query.
 //
-// Which FCL paths copy (FCL 0.7, collision_func_matrix-inl.h / distance_func_matrix-inl.h):
-// fcl::collide / fcl::distance with a non-oriented BV (AABB) copy the BVHModel(s) with
-// `new BVHModel(*obj)` on every call (shape-vs-mesh and mesh-vs-mesh alike), then rebuild or
-// refit the copy if the pose is not the identity: that was the earlier 0.7 ms capsule query.
-// Oriented BVs (OBBRSS) do not copy but their refit is slow (~49 ms for all tet faces). So
-// touches() builds the traversal node itself (fcl::detail::initialize with identity poses
-// transforms nothing and copies nothing) and runs fcl::detail::distance on it: no copy, no
-// allocation.
+// Which FCL paths copy (FCL 0.7, narrowphase/detail/collision_func_matrix-inl.h and
+// distance_func_matrix-inl.h): fcl::collide / fcl::distance with a non-oriented BV (AABB) copy
+// the BVHModel(s) with `new BVHModel(*obj)` on every call (shape-vs-mesh and mesh-vs-mesh
+// alike), and transform + refit the copy when the pose is not the identity: that was the
+// earlier capsule query's 0.7 ms. Oriented BVs (OBBRSS) do not copy but their refit is slow
+// (~49 ms for all tet faces). So touches() builds the traversal node itself
+// (fcl::detail::initialize with identity poses transforms nothing, copies nothing) and runs
+// fcl::detail::distance on it: no copy, no allocation (tested with the allocation counter).
+// The full refit is one backward loop over FCL's nodes (children are numbered after their
+// parent, checked at build), ~2x faster than endReplaceModel(true, true).
 //
-// Cost on the shaving scene's mesh (assets/uterus_myoma.msh, ./build/bench/bench_collision,
-// medians of 5 repetitions, 2-core machine shared with other builds): see the table in
-// bench/bench_collision.cpp; refit of the boundary hierarchy ~MEASURED, a query ~MEASURED.
+// Cost on the shaving scene's mesh (assets/uterus_myoma.msh: 3378 boundary faces, 1691 of
+// its 2865 nodes; ./build/bench/bench_collision, medians of 5 repetitions, CPU time, on the
+// 2-core machine shared with other builds, so +-30%):
+//   full refit, boundary 59 us (all tet faces: 471 us; FCL's own bottom-up refit ~100 us)
+//   update() with no vertex past the 0.5 mm margin 2.4 us; SweptWire::update 0.9 us
+//   touches(): loop crossing the myoma's surface 2.9 us, buried 2.0 us, in the fluid 0.4 us
+//   (exact boxes, margin 0: 1.4 / 1.0 us; all tet faces: 21 / 17 us)
+//   a real active step (BM_ShavingPassSweep: 300 recorded steps of pass 1, ~17 vertices a
+//   step leave their margin, a jittering node among them): median 9.8 us, p99 28 us; the
+//   earlier 17-point TetLocator test on the same steps: median 17 us, p99 42 us.
+// In the whole shaving run (perf record of ./build/tools/hysim run scenes/shaving.yaml)
+// collision is 0.7% of the samples, ~20 us per active step.
 #include <Eigen/Core>
 #include <memory>
 
@@ -73,16 +88,19 @@ class TissueCollision {
   // Moves the hierarchy's vertices to x (same mesh) and refits the boxes bottom-up in place,
   // keeping the tree. Allocates nothing.
   void refit(const sim::NodeVectors& x);
-  // Moves the vertices to x and refits only if a vertex has moved further than the margin
-  // since the last refit (O(#V) check; a margin of 0 refits every time). Returns whether it
-  // refitted. Allocates nothing.
+  // Moves the vertices to x; a vertex that has moved further than the margin since its boxes
+  // were fitted gets the leaf boxes of its triangles refitted and their ancestors grown (a
+  // local refit, O(#V) check plus O(depth) per moved vertex; boxes only grow until the next
+  // refit()). A margin of 0 refits everything every time. Returns whether a box changed.
+  // Allocates nothing.
   bool update(const sim::NodeVectors& x);
   // Does the swept wire, thickened by `radius`, touch a triangle? Allocates nothing.
   bool touches(const SweptWire& sweep, double radius) const;
   int numFaces() const;
   int numVertices() const;  // distinct nodes of the faces
   double margin() const;
-  long numRefits() const;   // since construction (build included)
+  long numRefits() const;       // full refits since construction (build included)
+  long numLocalRefits() const;  // vertices refitted locally by update()
 
  private:
   struct Impl;

@@ -138,6 +138,12 @@ class Simulation {
   LoopGeometry loop_;
   TissueCollision collision_;  // boundary faces, refitted only while the electrode is active
   SweptWire swept_wire_;       // the wire's motion in the last step
+  bool collision_active_ = false;  // the hierarchy was refitted and is followed step by step
+  // Whether the wire is buried (in the tissue, touching no surface), known since the last
+  // contact: without contact the wire cannot change sides, so one TetLocator test per
+  // contact-free stretch is enough.
+  bool buried_known_ = false;
+  bool buried_ = false;
   TetLocator locator_;
   Eigen::Matrix<double, Eigen::Dynamic, 3> wire_, previous_wire_;
   Sweep sweep_;

@@ -4,8 +4,8 @@
 // current node positions, so the grid stays valid while no node has moved further than the
 // margin since the build (the caller rebuilds when one has, and after topology changes).
 //
-// (FCL was measured for this first, see collision.hpp: its AABB models are copied and
-// rebuilt on every query, 0.7 ms, too slow for every 1 ms step.)
+// The step uses it only for the wire's "buried" case, once per contact-free stretch: contact
+// with the tissue's surface is FCL's job (collision.hpp).
 #include <Eigen/Core>
 #include <vector>
 
