@@ -261,34 +261,50 @@ Result<std::unique_ptr<Simulation>> Simulation::create(const Scene& scene) {
 }
 
 void Simulation::computeContact() {
+  // The tool's pose is fixed for the step; the forces are computed per substep (below).
   const ContactSettings& c = scene_.contact;
-  tool_force_n_.setZero();
-  for (int node : contact_nodes_) contact_force_.row(node).setZero();
-  if (!c.enabled) return;
   const Eigen::Vector3d axis = pose_.rotation.col(2);
   const Eigen::Vector3d up = pose_.rotation.col(1);
-  const Eigen::Vector3d shaft_a = pose_.tip - c.shaft_length_mm * axis;
-  const Eigen::Vector3d shaft_b = pose_.tip;
-  const Eigen::Vector3d loop = pose_.tip + (c.loop_reach_mm + pose_.extension_mm) * axis - c.loop_drop_mm * up;
+  contact_shaft_a_ = pose_.tip - c.shaft_length_mm * axis;
+  contact_shaft_b_ = pose_.tip;
+  contact_loop_ = pose_.tip + (c.loop_reach_mm + pose_.extension_mm) * axis - c.loop_drop_mm * up;
+  tool_force_n_.setZero();
+  contact_calls_ = 0;
+  for (int node : contact_nodes_) contact_force_.row(node).setZero();
+}
+
+void Simulation::contactForces(void* self, const sim::NodeVectors& x, const sim::NodeVectors& v) {
+  static_cast<Simulation*>(self)->contactForces(x, v);
+}
+
+void Simulation::contactForces(const sim::NodeVectors& x, const sim::NodeVectors& v) {
+  // Called by the integrator before each substep, with that substep's positions: the penalty
+  // is then as explicit as the springs, at the substep's dt, which the springs' stability
+  // already bounds (a force held over the whole step made light canal nodes bounce 2 mm in
+  // and out of the sheath every step). The reaction on the tool is the substeps' mean.
+  const ContactSettings& c = scene_.contact;
+  for (int node : contact_nodes_) contact_force_.row(node).setZero();
+  if (!c.enabled) return;
   const double k = c.stiffness_n_per_mm * 1e6;   // N/mm -> uN/mm
   const double d = c.damping_n_s_per_mm * 1e6;   // N s/mm -> uN s/mm
   // The shaft and the (inactive) loop push tissue: penalty along the separation direction.
   auto push = [&](int node, const Eigen::Vector3d& closest, double radius) {
-    const Eigen::Vector3d p = state_.x.row(node).transpose();
+    const Eigen::Vector3d p = x.row(node).transpose();
     Eigen::Vector3d n = p - closest;
     const double dist = n.norm();
     if (dist >= radius || dist <= 1e-12) return;
     n /= dist;
-    const double vn = state_.v.row(node).dot(n);
+    const double vn = v.row(node).dot(n);
     const double mag = std::max(0.0, k * (radius - dist) - d * vn);
     contact_force_.row(node) += mag * n.transpose();
     tool_force_n_ -= 1e-6 * mag * n;
   };
   for (int node : contact_nodes_) {
-    const Eigen::Vector3d p = state_.x.row(node).transpose();
-    push(node, closestOnSegment(p, shaft_a, shaft_b), c.shaft_radius_mm);
-    if (!pose_.pedal) push(node, loop, c.loop_radius_mm);  // an active electrode cuts instead
+    const Eigen::Vector3d p = x.row(node).transpose();
+    push(node, closestOnSegment(p, contact_shaft_a_, contact_shaft_b_), c.shaft_radius_mm);
+    if (!pose_.pedal) push(node, contact_loop_, c.loop_radius_mm);  // an active electrode cuts instead
   }
+  ++contact_calls_;
 }
 
 bool Simulation::loopTouchesTissue() {
@@ -325,7 +341,10 @@ void Simulation::step() {
   computeContact();
   sim::StepInput input;
   input.external_force = &contact_force_;
+  input.refresh_external = &Simulation::contactForces;
+  input.context = this;
   sim::step(model_, state_, input);
+  if (contact_calls_ > 1) tool_force_n_ /= static_cast<double>(contact_calls_);
   device_->commandForce(tool_force_n_);  // clamped and NaN-guarded by the device
   if (chips_) {
     chips_->moveTool(pose_);
@@ -417,13 +436,68 @@ void Simulation::finishPass() {
     rec.sweep_area_mm2 +=
         0.5 * (sv.row(sf(t, 1)) - sv.row(sf(t, 0))).cross(sv.row(sf(t, 2)) - sv.row(sf(t, 0))).norm();
   }
-  auto surface = cutting::CutSurface::triangles(sv, sf);
+  // The cut happens in the rest configuration, so that the mesh the model is built from (and
+  // the cut's quality guarantees) are the cut's own, not a deformed copy mapped back. The
+  // sweep is first thinned to rows ~0.3 mm apart (it holds a row every step, a few um apart),
+  // then each of its points is carried from the deformed tissue to the rest shape through the
+  // tet that contains it (outside the tissue: the affine map of a tet at the nearest surface
+  // node, which continues the deformation smoothly).
+  const int row_size = static_cast<int>(wire_.rows());
+  const int rows = static_cast<int>(sv.rows()) / row_size;
+  std::vector<int> kept_rows{0};
+  for (int r = 1; r < rows; ++r) {
+    const int last = kept_rows.back();
+    const double moved = (sv.row(r * row_size + row_size / 2) - sv.row(last * row_size + row_size / 2)).norm();
+    if (moved >= 0.3 || r == rows - 1) kept_rows.push_back(r);
+  }
+  if (locator_.maxDisplacement(state_.x) > locator_.margin()) locator_.build(mesh_, state_.x);
+  // Barycentric coordinates of p in tet t at positions x (may lie outside [0, 1]).
+  auto barycentric = [&](int t, const Eigen::Vector3d& p) {
+    const Eigen::Vector3d a = state_.x.row(mesh_.T(t, 0)).transpose();
+    Eigen::Matrix3d m;
+    for (int k = 0; k < 3; ++k) m.col(k) = state_.x.row(mesh_.T(t, k + 1)).transpose() - a;
+    const Eigen::Vector3d w = m.inverse() * (p - a);
+    return Eigen::Vector4d(1.0 - w.sum(), w[0], w[1], w[2]);
+  };
+  std::vector<int> node_tet(mesh_.numNodes(), -1);  // a tet around each surface node
+  for (int t = 0; t < mesh_.numTets(); ++t)
+    for (int k = 0; k < 4; ++k) node_tet[mesh_.T(t, k)] = t;
+  const int kept = static_cast<int>(kept_rows.size());
+  cutting::Positions rv(static_cast<Eigen::Index>(kept) * row_size, 3);
+  for (int r = 0; r < kept; ++r)
+    for (int i = 0; i < row_size; ++i) {
+      const Eigen::Vector3d p = sv.row(kept_rows[r] * row_size + i).transpose();
+      int t = locator_.locate(mesh_, state_.x, p);
+      if (t < 0) {
+        int nearest = -1;
+        double best = std::numeric_limits<double>::infinity();
+        for (int node : surface_nodes_) {
+          const double d = (state_.x.row(node).transpose() - p).squaredNorm();
+          if (d < best) {
+            best = d;
+            nearest = node;
+          }
+        }
+        if (nearest < 0) return fail("no tissue to map the sweep to");
+        t = node_tet[nearest];
+      }
+      const Eigen::Vector4d w = barycentric(t, p);
+      Eigen::RowVector3d q = Eigen::RowVector3d::Zero();
+      for (int k = 0; k < 4; ++k) q += w[k] * mesh_.X.row(mesh_.T(t, k));
+      rv.row(static_cast<Eigen::Index>(r) * row_size + i) = q;
+    }
+  cutting::Tris rf(static_cast<Eigen::Index>(2 * (kept - 1) * (row_size - 1)), 3);
+  for (int r = 0, f = 0; r + 1 < kept; ++r)
+    for (int i = 0; i + 1 < row_size; ++i) {
+      const int a0 = r * row_size + i, b0 = a0 + 1, c0 = a0 + row_size, d0 = c0 + 1;
+      rf.row(f++) << a0, b0, d0;
+      rf.row(f++) << a0, d0, c0;
+    }
+  auto surface = cutting::CutSurface::triangles(rv, rf);
   if (!surface.ok()) return fail(surface.error());
-  cutting::TetMesh current = mesh_;  // the cut happens in the deformed configuration
-  current.X = state_.x;
   cutting::Cut3DOptions options;
   options.method = cutting::CutMethod::Hybrid;
-  auto cut = cutting::cut3d(current, *surface, options);
+  auto cut = cutting::cut3d(mesh_, *surface, options);
   if (!cut.ok()) return fail(cut.error());
   const cutting::TopologyChange& change = cut->change;
   rec.crossed_edges = cut->report.crossed_edges;
@@ -433,16 +507,16 @@ void Simulation::finishPass() {
   rec.cut_faces = cut->report.cut_faces;
   const cutting::TetMesh& after = cut->mesh;
 
-  // Rest positions and velocities of the new mesh: surviving nodes keep theirs (plus what
-  // the cut moved them by); new nodes interpolate their parents.
+  // Current positions and velocities of the new mesh: surviving nodes keep theirs (plus what
+  // the cut moved them by in the rest shape); new nodes interpolate their parents.
   const int n = after.numNodes();
-  cutting::Positions rest(n, 3);
-  sim::NodeVectors v(n, 3);
+  const cutting::Positions& rest = after.X;
+  sim::NodeVectors xnew(n, 3), v(n, 3);
   std::vector<char> known(n, 0);
   for (int i = 0; i < static_cast<int>(change.node_old_to_new.size()); ++i) {
     const int j = change.node_old_to_new[i];
     if (j < 0 || known[j]) continue;
-    rest.row(j) = mesh_.X.row(i) + (after.X.row(j) - current.X.row(i));
+    xnew.row(j) = state_.x.row(i) + (after.X.row(j) - mesh_.X.row(i));
     v.row(j) = state_.v.row(i);
     known[j] = 1;
   }
@@ -451,10 +525,10 @@ void Simulation::finishPass() {
     Eigen::RowVector3d r = Eigen::RowVector3d::Zero(), x = r, vel = r;
     for (int k = 0; k < nn.num_parents; ++k) {
       r += nn.weights[k] * mesh_.X.row(nn.parents[k]);
-      x += nn.weights[k] * current.X.row(nn.parents[k]);
+      x += nn.weights[k] * state_.x.row(nn.parents[k]);
       vel += nn.weights[k] * state_.v.row(nn.parents[k]);
     }
-    rest.row(nn.id) = r + (after.X.row(nn.id) - x);
+    xnew.row(nn.id) = x + (after.X.row(nn.id) - r);
     v.row(nn.id) = vel;
     known[nn.id] = 1;
   }
@@ -498,7 +572,7 @@ void Simulation::finishPass() {
   for (int i = 0; i < n; ++i) {
     if (new_index[i] < 0) continue;
     rest_mesh.X.row(new_index[i]) = rest.row(i);
-    x_kept.row(new_index[i]) = after.X.row(i);
+    x_kept.row(new_index[i]) = xnew.row(i);
     v_kept.row(new_index[i]) = v.row(i);
   }
   rest_mesh.T.resize(static_cast<Eigen::Index>(keep_tets.size()), 4);
@@ -507,9 +581,6 @@ void Simulation::finishPass() {
     for (int c = 0; c < 4; ++c) rest_mesh.T(static_cast<Eigen::Index>(k), c) = new_index[after.T(keep_tets[k], c)];
     rest_mesh.material[static_cast<Eigen::Index>(k)] = after.material[keep_tets[k]];
   }
-  // If mapping the cut back to rest positions inverted anything (large deformation at the
-  // cut), the current shape becomes the rest shape: the tissue relaxes there.
-  if (!cutting::validate(rest_mesh).ok()) rest_mesh.X = x_kept;
   // Nodes on a cut surface, this pass's and earlier ones', in the new numbering.
   std::vector<std::uint8_t> on_cut(n, 0);
   for (int i = 0; i < static_cast<int>(change.node_old_to_new.size()); ++i) {
@@ -531,7 +602,11 @@ void Simulation::finishPass() {
   }
   outer_wall_.remapNodes(old_to_kept);
   std::vector<ChipShape> chip_shapes;
-  if (chips_) chip_shapes = chipShapes(after, v, comps, on_cut, scene_.materials, myoma_label);
+  if (chips_) {
+    cutting::TetMesh deformed = after;  // chips start where the pieces are now
+    deformed.X = xnew;
+    chip_shapes = chipShapes(deformed, v, comps, on_cut, scene_.materials, myoma_label);
+  }
   if (Status st = setTopology(std::move(rest_mesh), &x_kept, &v_kept); !st.ok()) return fail(st.error());
   for (const ChipShape& chip : chip_shapes) chips_->addChip(chip);  // after the cavity is rebuilt
   const cutting::MeshStats stats = cutting::computeStats(mesh_);

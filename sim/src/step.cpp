@@ -102,6 +102,7 @@ void stepSymplecticEuler(const Model& m, State& s, const StepInput& in) {
   const double drag = 1.0 / (1.0 + h * m.options.drag_per_s);  // implicit drag: stable for any h
   const int n = m.num_nodes;
   for (int sub = 0; sub < m.substeps; ++sub) {
+    if (in.refresh_external != nullptr) in.refresh_external(in.context, s.x, s.v);
     accumulateForces(m, s.x, s.v, in, s);
     double* v = s.v.data();
     double* x = s.x.data();
@@ -126,6 +127,7 @@ void stepImplicitEuler(const Model& m, State& s, const StepInput& in) {
   NodeVectors& x0 = s.scratch0;    // x_n
   NodeVectors& base = s.scratch1;  // constant part of the right-hand side (full #N rows)
   x0 = s.x;
+  if (in.refresh_external != nullptr) in.refresh_external(in.context, s.x, s.v);
   const double alpha = m.options.drag_per_s;
   const Eigen::Vector3d& g = m.options.gravity;
 

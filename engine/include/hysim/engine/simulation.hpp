@@ -107,6 +107,8 @@ class Simulation {
  private:
   Simulation() = default;
   void computeContact();
+  static void contactForces(void* self, const sim::NodeVectors& x, const sim::NodeVectors& v);
+  void contactForces(const sim::NodeVectors& x, const sim::NodeVectors& v);
   // Replaces the mesh (rest positions) and everything built from it; x, v (#N x 3) are the
   // current positions and velocities (null: rest and zero).
   Status setTopology(cutting::TetMesh rest_mesh, const sim::NodeVectors* x, const sim::NodeVectors* v);
@@ -130,6 +132,8 @@ class Simulation {
   std::vector<int> contact_nodes_;                // free surface nodes (contact candidates)
   sim::NodeVectors contact_force_;                // #N x 3, uN
   Eigen::Vector3d tool_force_n_{0, 0, 0};
+  Eigen::Vector3d contact_shaft_a_{0, 0, 0}, contact_shaft_b_{0, 0, 0}, contact_loop_{0, 0, 0};  // this step's tool
+  int contact_calls_ = 0;                         // substeps that computed contact this step
   render::SurfaceMesh tool_surface_;              // body frame
   int num_anchored_ = 0;
   int num_deformable_tets_ = 0;

@@ -104,6 +104,11 @@ struct State {
 
 struct StepInput {
   const NodeVectors* external_force = nullptr;  // #N x 3 uN (contact), or null
+  // Optional: called with the current positions and velocities before each substep's forces
+  // (symplectic Euler; once per step for implicit Euler), to refresh *external_force, e.g.
+  // contact that follows the tissue within the step. A plain function pointer: no allocation.
+  void (*refresh_external)(void* context, const NodeVectors& x, const NodeVectors& v) = nullptr;
+  void* context = nullptr;
 };
 
 // Builds the model. `fixed_nodes` are anchored at their rest positions. Materials are looked
