@@ -27,7 +27,7 @@ namespace {
 using Vec3 = Eigen::Vector3d;
 constexpr int kFace[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
 
-enum class Freedom { Free, Plane, Fixed };
+enum class Freedom { Free, Plane, Surface, Fixed };
 struct Constraint {
   Freedom kind = Freedom::Fixed;
   Vec3 normal = Vec3::Zero();  // Plane: moves are perpendicular to it
@@ -137,9 +137,11 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       }
       if (!boundary || sum.norm() == 0) return c;
       c.normal = sum.normalized();
+      // A curved cut surface: slide in the tangent plane, then back onto the surface (the
+      // volume changes by second-order amounts), where the cut faces around are smooth.
+      c.kind = Freedom::Surface;
       for (const auto& bf : faces)
-        if (bf.count == 1 && bf.area.normalized().dot(c.normal) < 1.0 - 1e-9) return c;
-      c.kind = Freedom::Plane;
+        if (bf.count == 1 && bf.area.normalized().dot(c.normal) < cosFlat) c.kind = Freedom::Fixed;
       return c;
     }
     if (!boundary) {
@@ -429,8 +431,90 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       }
     std::sort(cands.begin(), cands.end());
     cands.erase(std::unique(cands.begin(), cands.end()), cands.end());
-    std::vector<std::int32_t> dying, changing;
-    std::vector<Vec3> targets;
+    std::vector<std::int32_t> dying, changing, group, tets;
+    std::vector<Vec3> targets, groupTo, groupFrom;
+    const double near = options.collapse_fraction * region.edge_length;
+    auto inGroup = [&](int v) { return std::find(group.begin(), group.end(), v) != group.end(); };
+    // Moves the group onto the cut and removes the tets that go flat, if that passes the
+    // checks; otherwise leaves everything as it was and names a near node (not on the cut, not
+    // in the group) of the tet that failed, if there is one.
+    auto trySnap = [&](int* partner) {
+      tets.clear();
+      for (int g : group)
+        for (int s = off[g]; s < off[g + 1]; ++s)
+          if (!(*dead)[star[s]]) tets.push_back(star[s]);
+      std::sort(tets.begin(), tets.end());
+      tets.erase(std::unique(tets.begin(), tets.end()), tets.end());
+      dying.clear();
+      changing.clear();
+      double oldMin = 1.0, newMin = 1.0, before = 0, after = 0;
+      int worstTet = -1;
+      for (int t : tets) {
+        int onAfter = 0;
+        Vec3 p[4];
+        for (int k = 0; k < 4; ++k) {
+          const int v = mesh.T(t, k);
+          onAfter += onCut[v] || inGroup(v);
+          p[k] = pos(v);
+          for (size_t g = 0; g < group.size(); ++g)
+            if (group[g] == v) p[k] = groupTo[g];
+        }
+        oldMin = std::min(oldMin, tetQ(t));
+        before += tetVolume(mesh, t);
+        if (onAfter == 4) {
+          dying.push_back(t);
+          continue;
+        }
+        changing.push_back(t);
+        const double vol = (p[1] - p[0]).dot((p[2] - p[0]).cross(p[3] - p[0])) / 6.0;
+        const double q = vol > 0 ? radiusRatio(p[0], p[1], p[2], p[3]) : -1.0;
+        if (q < newMin) {
+          newMin = q;
+          worstTet = t;
+        }
+        after += vol;
+      }
+      const double change = std::abs(after - before);
+      if (newMin < oldMin && worstTet >= 0) {
+        for (int k = 0; k < 4; ++k) {
+          const int v = mesh.T(worstTet, k);
+          if (!onCut[v] && !inGroup(v) && std::abs(region.surface->signedDistance(pos(v))) < near) *partner = v;
+        }
+      }
+      if (dying.empty() || changing.empty() || newMin < oldMin ||
+          change > options.collapse_volume_fraction * before || change > budget)
+        return false;
+      groupFrom.clear();
+      for (size_t g = 0; g < group.size(); ++g) {
+        groupFrom.push_back(pos(group[g]));
+        mesh.X.row(group[g]) = groupTo[g].transpose();
+      }
+      for (int t : dying) (*dead)[t] = 1;
+      bool ok = true;
+      for (size_t g = 0; g < group.size() && ok; ++g) {
+        liveStar(group[g], around, nullptr);
+        ok = discAround(group[g], around);
+      }
+      for (size_t i = 0; i < dying.size() && ok; ++i)
+        for (int k = 0; k < 4 && ok; ++k) {
+          const int w = mesh.T(dying[i], k);
+          if (inGroup(w)) continue;
+          liveStar(w, around, nullptr);
+          ok = discAround(w, around);
+        }
+      if (!ok) {
+        for (int t : dying) (*dead)[t] = 0;
+        for (size_t g = 0; g < group.size(); ++g) mesh.X.row(group[g]) = groupFrom[g].transpose();
+        return false;
+      }
+      for (int g : group) {
+        onCut[g] = 1;
+        lateSnapped.push_back(g);
+        if (counts) ++counts->late_snaps;
+      }
+      budget -= change;
+      return true;
+    };
     for (const auto& [dist, u] : cands) {
       if (onCut[u]) continue;
       // Targets: the nearest point of the cut, then the nearest points of the edges between
@@ -453,55 +537,26 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       }
       for (const Vec3& y : targets) {
         if ((y - pos(u)).norm() > options.collapse_fraction * region.edge_length) continue;
-        dying.clear();
-        changing.clear();
-        double oldMin = 1.0, newMin = 1.0, before = 0, after = 0;
-        bool ok = true;
-        for (int s = off[u]; s < off[u + 1] && ok; ++s) {
-          const int t = star[s];
-          if ((*dead)[t]) continue;
-          int others = 0;
-          for (int k = 0; k < 4; ++k) others += mesh.T(t, k) != u && onCut[mesh.T(t, k)];
-          oldMin = std::min(oldMin, tetQ(t));
-          before += tetVolume(mesh, t);
-          if (others == 3) {
-            dying.push_back(t);
-            continue;
+        // The moving set: u, plus (up to two) near nodes next to it that must come along (a
+        // tet that would go flat or get worse because another of its nodes is also near the
+        // cut): they move to their nearest points of the cut.
+        group.assign({u});
+        groupTo.assign({y});
+        bool done = false;
+        while (!done) {
+          int partner = -1;
+          const bool ok = trySnap(&partner);
+          if (ok) {
+            done = true;
+            break;
           }
-          changing.push_back(t);
-          const double q = tetQAt(t, u, y);
-          if (q < 0) ok = false;
-          newMin = std::min(newMin, q);
-          Vec3 p[4];
-          for (int k = 0; k < 4; ++k) p[k] = mesh.T(t, k) == u ? y : pos(mesh.T(t, k));
-          after += (p[1] - p[0]).dot((p[2] - p[0]).cross(p[3] - p[0])) / 6.0;
+          if (partner < 0 || group.size() >= 3) break;
+          Vec3 z;
+          region.surface->signedDistance(pos(partner), &z);
+          group.push_back(partner);
+          groupTo.push_back(z);
         }
-        const double change = std::abs(after - before);
-        if (!ok || dying.empty() || changing.empty() || newMin < oldMin ||
-            change > options.collapse_volume_fraction * before || change > budget)
-          continue;
-        const Vec3 x = pos(u);
-        for (int t : dying) (*dead)[t] = 1;
-        mesh.X.row(u) = y.transpose();
-        liveStar(u, around, nullptr);
-        ok = discAround(u, around);
-        for (size_t i = 0; i < dying.size() && ok; ++i)
-          for (int k = 0; k < 4 && ok; ++k) {
-            const int w = mesh.T(dying[i], k);
-            if (w == u) continue;
-            liveStar(w, around, nullptr);
-            ok = discAround(w, around);
-          }
-        if (!ok) {
-          for (int t : dying) (*dead)[t] = 0;
-          mesh.X.row(u) = x.transpose();
-          continue;
-        }
-        onCut[u] = 1;
-        lateSnapped.push_back(u);
-        budget -= change;
-        if (counts) ++counts->late_snaps;
-        break;
+        if (done) break;
       }
     }
   };
@@ -562,7 +617,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       const double before = starWorst(n, x, &wt);
       if (before < 0 || before >= options.quality_target || wt < 0) continue;
       auto project = [&](Vec3 d) {
-        if (c.kind == Freedom::Plane) d -= d.dot(c.normal) * c.normal;
+        if (c.kind == Freedom::Plane || c.kind == Freedom::Surface) d -= d.dot(c.normal) * c.normal;
         return d;
       };
       // Unit direction of the allowed part of d (zero when d is (nearly) all normal: the
@@ -619,7 +674,8 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
         if (d.squaredNorm() == 0) continue;
         double step = 1.0;
         for (int tries = 0; tries < 5; ++tries, step *= 0.5) {
-          const Vec3 y = x + step * d;
+          Vec3 y = x + step * d;
+          if (c.kind == Freedom::Surface) region.surface->signedDistance(Vec3(y), &y);
           if (!sideKept(n, x, y)) continue;
           const double q = starWorst(n, y, nullptr);
           if (q > best) {

@@ -281,12 +281,15 @@ void Simulation::contactForces(const sim::NodeVectors& x, const sim::NodeVectors
   // Called by the integrator before each substep, with that substep's positions: the penalty
   // is then as explicit as the springs, at the substep's dt, which the springs' stability
   // already bounds (a force held over the whole step made light canal nodes bounce 2 mm in
-  // and out of the sheath every step). The reaction on the tool is the substeps' mean.
+  // and out of the sheath every step), except for very light nodes (small elements left by
+  // cuts): their penalty is capped at 0.5 m / h^2 for the substep h, which keeps them stable.
+  // The reaction on the tool is the substeps' mean.
   const ContactSettings& c = scene_.contact;
   for (int node : contact_nodes_) contact_force_.row(node).setZero();
   if (!c.enabled) return;
   const double k = c.stiffness_n_per_mm * 1e6;   // N/mm -> uN/mm
   const double d = c.damping_n_s_per_mm * 1e6;   // N s/mm -> uN s/mm
+  const double h = model_.substep;
   // The shaft and the (inactive) loop push tissue: penalty along the separation direction.
   auto push = [&](int node, const Eigen::Vector3d& closest, double radius) {
     const Eigen::Vector3d p = x.row(node).transpose();
@@ -295,7 +298,9 @@ void Simulation::contactForces(const sim::NodeVectors& x, const sim::NodeVectors
     if (dist >= radius || dist <= 1e-12) return;
     n /= dist;
     const double vn = v.row(node).dot(n);
-    const double mag = std::max(0.0, k * (radius - dist) - d * vn);
+    const double m = model_.mass[node];
+    const double kn = std::min(k, 0.5 * m / (h * h)), dn = std::min(d, m / h);
+    const double mag = std::max(0.0, kn * (radius - dist) - dn * vn);
     contact_force_.row(node) += mag * n.transpose();
     tool_force_n_ -= 1e-6 * mag * n;
   };
