@@ -63,6 +63,14 @@ TEST(Scene, DefaultSceneLoads) {
   EXPECT_DOUBLE_EQ(scene->sim.dt, 1e-3);
   EXPECT_GE(scene->tool_path.size(), 2u);
   EXPECT_TRUE(fs::exists(scene->mesh_path));
+  int pedal = 0;  // the default scene shaves: at least 10 passes with the cut pedal down
+  for (size_t k = 1; k < scene->tool_path.size(); ++k)
+    pedal += scene->tool_path[k].pedal && !scene->tool_path[k - 1].pedal;
+  EXPECT_GE(pedal, 10);
+  for (const char* other : {"/scenes/diagnostic.yaml", "/scenes/shaving.yaml"}) {
+    auto s = loadScene(std::string(HYSIM_SOURCE_DIR) + other);
+    EXPECT_TRUE(s.ok()) << other << ": " << s.error();
+  }
 }
 
 TEST(Scene, MinimalSceneLoadsWithDefaults) {

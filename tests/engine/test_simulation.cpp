@@ -10,8 +10,9 @@
 namespace hysim::engine {
 namespace {
 
+// The diagnostic look-around (no cutting): the loop presses on the myoma at 2 s.
 Scene defaultScene() {
-  auto scene = loadScene(std::string(HYSIM_SOURCE_DIR) + "/scenes/default.yaml");
+  auto scene = loadScene(std::string(HYSIM_SOURCE_DIR) + "/scenes/diagnostic.yaml");
   EXPECT_TRUE(scene.ok()) << scene.error();
   return *scene;
 }
