@@ -29,15 +29,17 @@ struct Cut2dCommands {
 std::shared_ptr<Cut2dCommands> addCut2dCommands(CLI::App& app) {
   auto c = std::make_shared<Cut2dCommands>();
   c->cut = app.add_subcommand("cut", "Cut a planar triangle mesh along a segment (2D hybrid cutting and baselines)");
-  c->cut->add_option("mesh", c->in, "Input mesh (.msh or .vtk, planar triangles)")->required()->check(CLI::ExistingFile);
+  // No CLI::ExistingFile check: the mesh readers name a missing file in the one-line error.
+  c->cut->add_option("mesh", c->in, "Input mesh (.msh or .vtk; planar triangles, or tets with --plane / --surface)")
+      ->required();
   c->cut->add_option("--line", c->line, "The cut segment x0,y0,x1,y1 (mm)");
   c->cut->add_option("--plane", c->plane, "Tet meshes: the cut plane px,py,pz,nx,ny,nz (mm)");
   c->cut->add_option("--surface", c->surface, "Tet meshes: an open cut surface (OBJ/STL/PLY, or .msh triangles)");
   c->cut->add_option("--method", c->method, "hybrid | standard | snap | delete (default hybrid)");
   c->cut->add_option("--out", c->out, "Output mesh (.msh or .vtk)")->required();
   c->cut->add_option("--stats", c->stats, "Write the output's statistics (hysim stats --json keys + time_ms) here");
-  c->tables = app.add_subcommand("tables", "Regenerate a paper table (1: 2D hybrid cutting)");
-  c->tables->add_option("--table", c->table, "Table number (1)")->required();
+  c->tables = app.add_subcommand("tables", "Regenerate a paper table (1: 2D hybrid cutting, 2: 3D hybrid cutting)");
+  c->tables->add_option("--table", c->table, "Table number (1 or 2)")->required();
   c->tables->add_option("--json", c->table1.json_path, "Write the rows as JSON here");
   c->tables->add_option("--pictures", c->table1.pictures_dir, "Write PNG pictures of each mesh before/after here");
   c->tables->add_option("--meshes", c->table1.meshes_dir, "Write the DistMesh test meshes (.msh) here");
@@ -110,6 +112,8 @@ std::optional<int> runCut2dCommands(const Cut2dCommands& c) {
     if (c.table == 2) {
       Table2Options t2;
       t2.json_path = c.table1.json_path;
+      t2.pictures_dir = c.table1.pictures_dir;
+      if (c.tables->count("--repeats") > 0) t2.repeats = c.table1.repeats;
       return runTable2(t2);
     }
     if (c.table != 1) return fail("--table: only tables 1 and 2 are implemented");

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <nlohmann/json.hpp>
@@ -14,6 +15,8 @@
 #include "hysim/cutting/mesh_io.hpp"
 #include "hysim/cutting/mesh_stats.hpp"
 #include "hysim/engine/simulation.hpp"
+#include "hysim/render/image.hpp"
+#include "tet_picture.hpp"
 #include "tool_common.hpp"
 
 namespace hysim::tools {
@@ -81,6 +84,7 @@ int runCut3d(const Cut3dArgs& a) {
     std::vector<double> v;
     if (!parseNumbers(a.plane, 6, &v)) return fail("--plane: expected px,py,pz,nx,ny,nz (six numbers), got '" + a.plane + "'");
     surface = cutting::CutSurface::plane(Eigen::Vector3d(v[0], v[1], v[2]), Eigen::Vector3d(v[3], v[4], v[5]));
+    if (!surface.ok()) return fail("--plane '" + a.plane + "': " + surface.error());
   } else {
     surface = loadCutSurface(a.surface);
   }
@@ -184,6 +188,32 @@ int runTable2(const Table2Options& o) {
   for (const auto* r : {&st, &ha, &hb})
     if (Status v = cutting::validate(r->result.mesh); !v.ok()) return fail("invalid cut mesh: " + v.error());
   out["table2"] = rows;
+  if (!o.pictures_dir.empty()) {
+    std::error_code ec;
+    std::filesystem::create_directories(o.pictures_dir, ec);
+    if (ec) return fail("cannot create pictures folder '" + o.pictures_dir + "': " + ec.message());
+    TetPictureOptions po;
+    po.frame_min = mesh.X.colwise().minCoeff().transpose();
+    po.frame_max = mesh.X.colwise().maxCoeff().transpose();
+    struct Picture {
+      const char* name;
+      const cutting::TetMesh* mesh;
+      const cutting::CutSurface* plane;
+    };
+    for (const Picture& p : {Picture{"table2_initial", &mesh, nullptr}, Picture{"table2_standard", &st.result.mesh, &planeA},
+                             Picture{"table2_hybrid_a", &ha.result.mesh, &planeA},
+                             Picture{"table2_hybrid_b", &hb.result.mesh, &planeB}}) {
+      po.has_plane = p.plane != nullptr;
+      if (p.plane) {
+        po.plane_point = p.plane->planePoint();
+        po.plane_normal = p.plane->planeNormal();
+      }
+      const std::string path = o.pictures_dir + "/" + p.name + ".png";
+      if (Status s = render::writePng(path, drawTetMesh(*p.mesh, po)); !s.ok()) return fail(s.error());
+    }
+    std::printf("\npictures in %s (table2_initial, _standard, _hybrid_a, _hybrid_b .png; pieces moved %.0f mm apart)\n",
+                o.pictures_dir.c_str(), po.gap);
+  }
 
   // Second block: successive parallel cuts through the uterus mesh.
   const std::string path = std::string(HYSIM_SOURCE_DIR) + "/assets/uterus_myoma.msh";

@@ -1,0 +1,153 @@
+// 3D cutting: one plane cut through the middle of a tet mesh plus the tissue update, the
+// time the acceptance of issue 4 bounds ("time per hybrid cut including optimisation and
+// tissue update: <= 5 ms on a 20,000-tet mesh"). Meshes: 0 = assets/uterus_myoma.msh (12,139
+// tets), 1 = tests/data/cutting/uterus_20k.msh (20,971 tets, the same geometry meshed finer,
+// see tests/data/cutting/README.md). Each iteration cuts the same input mesh with one of four
+// fixed planes through the bounding-box centre and updates the mass-spring model and state
+// (sim::updateModel3D: Van Gelder springs, moment-preserving masses; sim::remapState3D).
+// The benchmark's time is the whole (cut + optimisation + TopologyChange + update); the
+// counters split it: cut_ms (cut3d, incl. optimisation), optimize_ms, update_ms. Medians over
+// the repetitions (the `_median` rows). Run from anywhere:
+//   ./build/bench/bench_cut3d --benchmark_filter=BM_Cut3DUpdate
+#include <benchmark/benchmark.h>
+
+#include <chrono>
+#include <string>
+
+#include "hysim/cutting/cut3d.hpp"
+#include "hysim/cutting/mesh_io.hpp"
+#include "hysim/sim/model.hpp"
+#include "hysim/sim/tissue_update3d.hpp"
+
+namespace {
+
+using hysim::cutting::CutMethod;
+using hysim::cutting::TetMesh;
+using Vec3 = Eigen::Vector3d;
+
+struct Prepared {
+  TetMesh mesh;
+  hysim::sim::Model model;
+  hysim::sim::State state;
+  std::string name;
+  bool ok = false;
+};
+
+// The scene's materials (scenes/default.yaml): 1 = myometrium, 2 = myoma. Nodes outside the
+// ellipsoid (25, 20, 33) are anchored, as in the default scene.
+Prepared prepare(const std::string& path, const std::string& name) {
+  Prepared p;
+  p.name = name;
+  auto m = hysim::cutting::readTetMesh(path);
+  if (!m.ok()) return p;
+  p.mesh = std::move(*m);
+  hysim::sim::Material wall, myoma;
+  wall.label = 1;
+  wall.young_modulus_pa = 60e3;
+  myoma.label = 2;
+  myoma.young_modulus_pa = 150e3;
+  myoma.density_g_mm3 = 1.10e-3;
+  std::vector<int> fixed;
+  for (int i = 0; i < p.mesh.numNodes(); ++i) {
+    const Vec3 x = p.mesh.X.row(i).transpose();
+    if ((x.array() / Eigen::Array3d(25, 20, 33)).matrix().squaredNorm() > 1.0) fixed.push_back(i);
+  }
+  auto model = hysim::sim::buildModel(p.mesh, {wall, myoma}, fixed, {});
+  if (!model.ok()) return p;
+  p.model = std::move(*model);
+  p.state = hysim::sim::makeState(p.model, p.mesh);
+  p.ok = true;
+  return p;
+}
+
+const Prepared& mesh(int which) {
+  static const Prepared meshes[2] = {
+      prepare(std::string(HYSIM_SOURCE_DIR) + "/assets/uterus_myoma.msh", "uterus 12k"),
+      prepare(std::string(HYSIM_SOURCE_DIR) + "/tests/data/cutting/uterus_20k.msh", "uterus 20k")};
+  return meshes[which];
+}
+
+// Planes through the bounding-box centre (offset a little so that they do not pass exactly
+// through the symmetric geometry's nodes): transverse, sagittal, coronal, oblique.
+const Vec3 kNormals[4] = {{0.05, 0.1, 1.0}, {1.0, 0.12, 0.07}, {0.1, 1.0, 0.2}, {0.6, -0.5, 0.8}};
+const Vec3 kOffsets[4] = {{0.3, -0.2, 1.1}, {0.7, 0.4, -0.6}, {-0.5, 1.3, 0.2}, {0.2, 0.1, -2.4}};
+
+void BM_Cut3DUpdate(benchmark::State& state) {
+  const Prepared& p = mesh(static_cast<int>(state.range(0)));
+  const int plane = static_cast<int>(state.range(1));
+  hysim::cutting::Cut3DOptions o;
+  o.method = static_cast<CutMethod>(state.range(2));
+  if (!p.ok) {
+    state.SkipWithError("cannot read or model the mesh (assets/uterus_myoma.msh, tests/data/cutting/uterus_20k.msh)");
+    return;
+  }
+  const Vec3 lo = p.mesh.X.colwise().minCoeff().transpose(), hi = p.mesh.X.colwise().maxCoeff().transpose();
+  const auto surface = *hysim::cutting::CutSurface::plane(0.5 * (lo + hi) + kOffsets[plane], kNormals[plane].normalized());
+  double cutMs = 0, optMs = 0, updMs = 0;
+  int elements = 0, nodes = 0;
+  for (auto _ : state) {
+    const auto t0 = std::chrono::steady_clock::now();
+    auto r = hysim::cutting::cut3d(p.mesh, surface, o);
+    const auto t1 = std::chrono::steady_clock::now();
+    if (!r.ok()) {
+      state.SkipWithError(r.error().c_str());
+      return;
+    }
+    auto model = hysim::sim::updateModel3D(p.model, p.mesh, r->mesh, r->change);
+    if (!model.ok()) {
+      state.SkipWithError(model.error().c_str());
+      return;
+    }
+    auto s = hysim::sim::remapState3D(p.state, r->change);
+    const auto t2 = std::chrono::steady_clock::now();
+    benchmark::DoNotOptimize(s);
+    benchmark::DoNotOptimize(model);
+    cutMs += std::chrono::duration<double, std::milli>(t1 - t0).count();
+    updMs += std::chrono::duration<double, std::milli>(t2 - t1).count();
+    optMs += r->report.optimize_ms;
+    elements = r->mesh.numTets();
+    nodes = r->mesh.numNodes();
+  }
+  const double n = static_cast<double>(state.iterations());
+  state.counters["cut_ms"] = cutMs / n;
+  state.counters["optimize_ms"] = optMs / n;
+  state.counters["update_ms"] = updMs / n;
+  state.counters["tets"] = elements;
+  state.counters["nodes"] = nodes;
+  state.SetLabel(p.name + " plane " + std::to_string(plane) + " " + hysim::cutting::cutMethodName(o.method));
+}
+BENCHMARK(BM_Cut3DUpdate)
+    ->ArgsProduct({{0, 1}, {0, 1, 2, 3}, {static_cast<int>(CutMethod::Hybrid), static_cast<int>(CutMethod::Standard)}})
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(0.2)
+    ->Repetitions(5)
+    ->ReportAggregatesOnly(true);
+
+// The cut alone (cut3d incl. optimisation and TopologyChange), without the tissue update.
+void BM_Cut3D(benchmark::State& state) {
+  const Prepared& p = mesh(static_cast<int>(state.range(0)));
+  const int plane = static_cast<int>(state.range(1));
+  hysim::cutting::Cut3DOptions o;
+  o.method = static_cast<CutMethod>(state.range(2));
+  if (!p.ok) {
+    state.SkipWithError("cannot read the mesh");
+    return;
+  }
+  const Vec3 lo = p.mesh.X.colwise().minCoeff().transpose(), hi = p.mesh.X.colwise().maxCoeff().transpose();
+  const auto surface = *hysim::cutting::CutSurface::plane(0.5 * (lo + hi) + kOffsets[plane], kNormals[plane].normalized());
+  for (auto _ : state) {
+    auto r = hysim::cutting::cut3d(p.mesh, surface, o);
+    benchmark::DoNotOptimize(r);
+  }
+  state.SetLabel(p.name + " plane " + std::to_string(plane) + " " + hysim::cutting::cutMethodName(o.method));
+}
+BENCHMARK(BM_Cut3D)
+    ->ArgsProduct({{0, 1}, {0, 1, 2, 3}, {static_cast<int>(CutMethod::Hybrid), static_cast<int>(CutMethod::Standard)}})
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(0.2)
+    ->Repetitions(5)
+    ->ReportAggregatesOnly(true);
+
+}  // namespace
+
+BENCHMARK_MAIN();
