@@ -248,14 +248,28 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   };
   std::vector<std::int32_t> around;
   std::vector<std::int32_t> lateSnapped;  // nodes snapNear moved onto the cut
+  // The live tets around the seeds, each once, in index order.
+  std::vector<std::int32_t> tetMark(M, -1);
+  int markRound = 0;
+  auto regionTets = [&](std::vector<std::int32_t>& out) {
+    ++markRound;
+    out.clear();
+    for (int n : region.seeds)
+      for (int s = off[n]; s < off[n + 1]; ++s) {
+        const int t = star[s];
+        if ((*dead)[t] || tetMark[t] == markRound) continue;
+        tetMark[t] = markRound;
+        out.push_back(t);
+      }
+    std::sort(out.begin(), out.end());
+  };
   auto peel = [&]() {
     if (!(options.peel_quality > 0)) return;
     std::vector<std::int32_t> candidates;
-    for (int n : region.seeds)
-      for (int s = off[n]; s < off[n + 1]; ++s)
-        if (!(*dead)[star[s]] && tetQ(star[s]) < options.peel_quality) candidates.push_back(star[s]);
-    std::sort(candidates.begin(), candidates.end());
-    candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
+    regionTets(candidates);
+    candidates.erase(std::remove_if(candidates.begin(), candidates.end(),
+                                    [&](int t) { return !(tetQ(t) < options.peel_quality); }),
+                     candidates.end());
     for (bool again = true; again;) {
       again = false;
       for (int t : candidates) {
@@ -301,10 +315,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     for (int batch = 0; batch < 3; ++batch) {
       std::vector<Cand> cands;
       std::vector<std::int32_t> seen;
-      for (int n : region.seeds)
-        for (int s = off[n]; s < off[n + 1]; ++s) seen.push_back(star[s]);
-      std::sort(seen.begin(), seen.end());
-      seen.erase(std::unique(seen.begin(), seen.end()), seen.end());
+      regionTets(seen);
       for (int t : seen) {
         if ((*dead)[t]) continue;
         const double q = tetQ(t);
@@ -418,19 +429,18 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   auto snapNear = [&]() {
     if (!(options.collapse_fraction > 0) || region.surface == nullptr) return;
     std::vector<std::pair<double, std::int32_t>> cands;
-    for (int n : region.seeds)
-      for (int s = off[n]; s < off[n + 1]; ++s) {
-        const int t = star[s];
-        if ((*dead)[t]) continue;
-        for (int k = 0; k < 4; ++k) {
-          const int u = mesh.T(t, k);
-          if (onCut[u]) continue;
-          const double d = std::abs(region.surface->signedDistance(pos(u)));
-          if (d < options.collapse_fraction * region.edge_length) cands.emplace_back(d, u);
-        }
+    std::vector<std::int32_t> around0;
+    regionTets(around0);
+    std::vector<std::uint8_t> tried(N, 0);
+    for (int t : around0)
+      for (int k = 0; k < 4; ++k) {
+        const int u = mesh.T(t, k);
+        if (onCut[u] || tried[u]) continue;
+        tried[u] = 1;
+        const double d = std::abs(region.surface->signedDistance(pos(u)));
+        if (d < options.collapse_fraction * region.edge_length) cands.emplace_back(d, u);
       }
     std::sort(cands.begin(), cands.end());
-    cands.erase(std::unique(cands.begin(), cands.end()), cands.end());
     std::vector<std::int32_t> dying, changing, group, tets;
     std::vector<Vec3> targets, groupTo, groupFrom;
     const double near = options.collapse_fraction * region.edge_length;
