@@ -139,8 +139,8 @@ AnchorRegion parseAnchor(const Reader& r, const YAML::Node& n) {
 }
 
 void parseSimulation(const Reader& r, const YAML::Node& n, Scene& scene) {
-  r.checkKeys(n, "simulation", {"dt_ms", "steps", "integrator", "substeps", "implicit_iterations", "drag_per_s",
-                                "gravity_mm_s2", "max_speed_mm_s"});
+  r.checkKeys(n, "simulation", {"dt_ms", "steps", "integrator", "substeps", "max_substeps", "implicit_iterations",
+                                "drag_per_s", "gravity_mm_s2", "max_speed_mm_s"});
   if (n["dt_ms"]) {
     const double dt_ms = r.positive(n["dt_ms"], "dt_ms");
     if (dt_ms > 100.0) r.fail(n["dt_ms"], "'dt_ms' must be at most 100, got " + n["dt_ms"].Scalar());
@@ -157,6 +157,7 @@ void parseSimulation(const Reader& r, const YAML::Node& n, Scene& scene) {
     if (n["substeps"].IsScalar() && n["substeps"].Scalar() == "auto") scene.sim.substeps = 0;
     else scene.sim.substeps = r.integer(n["substeps"], "substeps", 1, 10000);
   }
+  if (n["max_substeps"]) scene.sim.max_substeps = r.integer(n["max_substeps"], "max_substeps", 1, 10000);
   if (n["implicit_iterations"]) scene.sim.implicit_iterations = r.integer(n["implicit_iterations"], "implicit_iterations", 1, 1000);
   if (n["drag_per_s"]) scene.sim.drag_per_s = r.nonNegative(n["drag_per_s"], "drag_per_s");
   if (n["gravity_mm_s2"]) scene.sim.gravity = r.vec3(n["gravity_mm_s2"], "gravity_mm_s2");
