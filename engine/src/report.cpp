@@ -153,6 +153,10 @@ std::string reportJson(const RunReport& r) {
     e["nodes"] = p.nodes;
     e["q_min"] = p.q_min;
     e["cut_ms"] = p.cut_ms;
+    e["cut_parts_ms"] = {{"map", p.map_ms},           {"cut3d", p.cut3d_ms},       {"remap", p.remap_ms},
+                         {"components", p.components_ms}, {"model", p.model_ms},   {"surface", p.surface_ms},
+                         {"collision", p.collision_ms}, {"locator", p.locator_ms}, {"chips", p.chips_ms},
+                         {"stats", p.stats_ms},         {"other", p.other_ms}};
     e["chips"] = p.chips;
     e["removed_mm3"] = p.removed_mm3;
     e["removed_myoma_mm3"] = p.removed_myoma_mm3;

@@ -102,6 +102,20 @@ std::vector<ChipShape> chipShapes(const cutting::TetMesh& after, const sim::Node
   return out;
 }
 
+// Wall time of the parts of a pass (measurement only: nothing simulated depends on it).
+// lap(&field) adds the time since the previous lap to field.
+class PassTimer {
+ public:
+  void lap(double* into) {
+    const auto now = std::chrono::steady_clock::now();
+    if (into != nullptr) *into += std::chrono::duration<double, std::milli>(now - last_).count();
+    last_ = now;
+  }
+
+ private:
+  std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
+};
+
 }  // namespace
 
 Result<render::SurfaceMesh> loadSurface(const std::string& path, render::SurfaceMaterial material) {
@@ -133,7 +147,9 @@ Result<render::SurfaceMesh> loadSurface(const std::string& path, render::Surface
   return out;
 }
 
-Status Simulation::setTopology(cutting::TetMesh rest_mesh, const sim::NodeVectors* x, const sim::NodeVectors* v) {
+Status Simulation::setTopology(cutting::TetMesh rest_mesh, const sim::NodeVectors* x, const sim::NodeVectors* v,
+                               PassRecord* timing) {
+  PassTimer timer;
   mesh_ = std::move(rest_mesh);
   std::vector<int> fixed;
   for (int i = 0; i < mesh_.numNodes(); ++i) {
@@ -164,6 +180,7 @@ Status Simulation::setTopology(cutting::TetMesh rest_mesh, const sim::NodeVector
     for (int c = 0; c < 4; ++c) moves = moves || !model_.fixed[mesh_.T(t, c)];
     num_deformable_tets_ += moves ? 1 : 0;
   }
+  timer.lap(timing ? &timing->model_ms : nullptr);
 
   // Surface for contact and rendering: boundary faces, compacted vertex numbering.
   Eigen::VectorXi face_tet;
@@ -202,13 +219,17 @@ Status Simulation::setTopology(cutting::TetMesh rest_mesh, const sim::NodeVector
     if (!model_.fixed[node]) contact_nodes_.push_back(node);
   }
   contact_force_ = sim::NodeVectors::Zero(mesh_.numNodes(), 3);
+  timer.lap(timing ? &timing->surface_ms : nullptr);
   // The boundary's hierarchy, with boxes grown by half a millimetre: while the tissue near
   // the loop moves less than that, a step only moves the vertices (see collision.hpp).
   if (Status st = collision_.build(surface_faces_, state_.x, 0.5); !st.ok()) return st;
   collision_active_ = true;  // just fitted
   buried_known_ = false;
+  timer.lap(timing ? &timing->collision_ms : nullptr);
   locator_.build(mesh_, state_.x);
+  timer.lap(timing ? &timing->locator_ms : nullptr);
   if (chips_) chips_->setCavity(state_.x, surface_faces_);
+  timer.lap(timing ? &timing->chips_ms : nullptr);
   ++topology_version_;
   return Status::Ok();
 }
@@ -417,6 +438,7 @@ void Simulation::checkPerforation() {
 void Simulation::finishPass() {
   using Clock = std::chrono::steady_clock;
   const auto t0 = Clock::now();
+  PassTimer timer;
   cutting_ = false;
   PassRecord rec;
   rec.time_s = state_.time;
@@ -495,10 +517,12 @@ void Simulation::finishPass() {
     }
   auto surface = cutting::CutSurface::triangles(rv, rf);
   if (!surface.ok()) return fail(surface.error());
+  timer.lap(&rec.map_ms);
   cutting::Cut3DOptions options;
   options.method = cutting::CutMethod::Hybrid;
   auto cut = cutting::cut3d(mesh_, *surface, options);
   if (!cut.ok()) return fail(cut.error());
+  timer.lap(&rec.cut3d_ms);
   const cutting::TopologyChange& change = cut->change;
   rec.crossed_edges = cut->report.crossed_edges;
   rec.snapped_nodes = cut->report.snapped_nodes;
@@ -532,6 +556,7 @@ void Simulation::finishPass() {
     v.row(nn.id) = vel;
     known[nn.id] = 1;
   }
+  timer.lap(&rec.remap_ms);
 
   // Chips: pieces connected to no anchored node are removed (their volume is resected).
   std::vector<int> anchored;
@@ -601,21 +626,29 @@ void Simulation::finishPass() {
     if (j >= 0 && j < n) old_to_kept[i] = new_index[j];
   }
   outer_wall_.remapNodes(old_to_kept);
+  timer.lap(&rec.components_ms);
   std::vector<ChipShape> chip_shapes;
   if (chips_) {
     cutting::TetMesh deformed = after;  // chips start where the pieces are now
     deformed.X = xnew;
     chip_shapes = chipShapes(deformed, v, comps, on_cut, scene_.materials, myoma_label);
   }
-  if (Status st = setTopology(std::move(rest_mesh), &x_kept, &v_kept); !st.ok()) return fail(st.error());
+  timer.lap(&rec.chips_ms);
+  if (Status st = setTopology(std::move(rest_mesh), &x_kept, &v_kept, &rec); !st.ok()) return fail(st.error());
+  timer.lap(nullptr);
   for (const ChipShape& chip : chip_shapes) chips_->addChip(chip);  // after the cavity is rebuilt
+  timer.lap(&rec.chips_ms);
   const cutting::MeshStats stats = cutting::computeStats(mesh_);
+  timer.lap(&rec.stats_ms);
   rec.elements = mesh_.numTets();
   rec.nodes = mesh_.numNodes();
   rec.q_min = stats.q_min;
   rec.substeps = model_.substeps;
   rec.added_mass_g = model_.added_mass;
   rec.cut_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+  rec.other_ms = std::max(0.0, rec.cut_ms - (rec.map_ms + rec.cut3d_ms + rec.remap_ms + rec.components_ms + rec.model_ms +
+                                             rec.surface_ms + rec.collision_ms + rec.locator_ms + rec.chips_ms +
+                                             rec.stats_ms));
   passes_.push_back(rec);
 }
 

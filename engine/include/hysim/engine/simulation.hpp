@@ -26,7 +26,14 @@ struct PassRecord {
   int elements = 0;          // after the pass (chips removed)
   int nodes = 0;
   double q_min = 0.0;        // q* = r_in / R_circ of the worst tet after the pass
-  double cut_ms = 0.0;       // cut + chip removal + model rebuild
+  double cut_ms = 0.0;       // cut + chip removal + model rebuild (the whole pass, wall time)
+  // cut_ms split into its parts (wall time, ms): carrying the sweep to the rest shape,
+  // cutting::cut3d, current positions of the cut mesh, free pieces found and removed (mesh
+  // compacted), the tissue model (masses, springs, stability), boundary/render/contact
+  // arrays, the FCL hierarchy, the tet locator, chip shapes and bodies, mesh statistics;
+  // other_ms is what is left (cut_ms minus the parts).
+  double map_ms = 0.0, cut3d_ms = 0.0, remap_ms = 0.0, components_ms = 0.0, model_ms = 0.0, surface_ms = 0.0,
+         collision_ms = 0.0, locator_ms = 0.0, chips_ms = 0.0, stats_ms = 0.0, other_ms = 0.0;
   int chips = 0;             // free pieces removed
   double removed_mm3 = 0.0;  // volume of the removed chips
   double removed_myoma_mm3 = 0.0;
@@ -111,7 +118,10 @@ class Simulation {
   void contactForces(const sim::NodeVectors& x, const sim::NodeVectors& v);
   // Replaces the mesh (rest positions) and everything built from it; x, v (#N x 3) are the
   // current positions and velocities (null: rest and zero).
-  Status setTopology(cutting::TetMesh rest_mesh, const sim::NodeVectors* x, const sim::NodeVectors* v);
+  // current positions and velocities (null: rest and zero). `timing` (optional) receives the
+  // wall time of the parts (model_ms, surface_ms, collision_ms, locator_ms, chips_ms).
+  Status setTopology(cutting::TetMesh rest_mesh, const sim::NodeVectors* x, const sim::NodeVectors* v,
+                     PassRecord* timing = nullptr);
   // Does the loop touch the tissue this step? Its sweep since the last step against the
   // boundary (FCL), else whether the wire is buried (one point in a tet).
   bool loopTouchesTissue();
