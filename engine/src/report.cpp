@@ -169,6 +169,8 @@ std::string reportJson(const RunReport& r) {
     e["components"] = p.components;
     e["substeps"] = p.substeps;
     e["added_mass_g"] = p.added_mass_g;
+    e["stability_nodes"] = p.stability_nodes;
+    e["global_stability"] = p.global_stability;
     if (p.cut_failed) e["failed"] = p.message;
     per_pass.push_back(e);
   }

@@ -6,12 +6,15 @@
 #include <algorithm>
 #include <assimp/Importer.hpp>
 #include <chrono>
+#include <cstdio>
+#include <cstdlib>
 #include <cmath>
 #include <limits>
 
 #include "hysim/cutting/cut3d.hpp"
 #include "hysim/cutting/mesh_io.hpp"
 #include "hysim/cutting/mesh_stats.hpp"
+#include "hysim/sim/tissue_update3d.hpp"
 
 namespace hysim::engine {
 namespace {
@@ -152,19 +155,29 @@ Status Simulation::setTopology(cutting::TetMesh rest_mesh, const sim::NodeVector
   PassTimer timer;
   mesh_ = std::move(rest_mesh);
   std::vector<int> fixed;
+  anchored_.assign(static_cast<size_t>(mesh_.numNodes()), 0);
   for (int i = 0; i < mesh_.numNodes(); ++i) {
-    const Eigen::Vector3d p = mesh_.X.row(i).transpose();
-    for (const AnchorRegion& a : scene_.anchors) {
-      if (a.contains(p)) {
-        fixed.push_back(i);
-        break;
-      }
+    if (isAnchored(mesh_.X.row(i).transpose())) {
+      anchored_[i] = 1;
+      fixed.push_back(i);
     }
   }
-  num_anchored_ = static_cast<int>(fixed.size());
   auto model = sim::buildModel(mesh_, scene_.materials, fixed, scene_.sim);
   if (!model.ok()) return Error{model.error()};
   model_ = std::move(model.value());
+  resetState(x, v);
+  timer.lap(timing ? &timing->model_ms : nullptr);
+  return rebuildGeometry(timing);
+}
+
+bool Simulation::isAnchored(const Eigen::Vector3d& rest) const {
+  for (const AnchorRegion& a : scene_.anchors) {
+    if (a.contains(rest)) return true;
+  }
+  return false;
+}
+
+void Simulation::resetState(const sim::NodeVectors* x, const sim::NodeVectors* v) {
   const int warnings = state_.warnings;
   const std::uint64_t steps = state_.steps;
   const double time = state_.time;
@@ -174,13 +187,18 @@ Status Simulation::setTopology(cutting::TetMesh rest_mesh, const sim::NodeVector
   state_.warnings = warnings;
   state_.steps = steps;
   state_.time = time;
+  num_anchored_ = 0;
+  for (std::uint8_t a : anchored_) num_anchored_ += a;
   num_deformable_tets_ = 0;
   for (int t = 0; t < mesh_.numTets(); ++t) {
     bool moves = false;
     for (int c = 0; c < 4; ++c) moves = moves || !model_.fixed[mesh_.T(t, c)];
     num_deformable_tets_ += moves ? 1 : 0;
   }
-  timer.lap(timing ? &timing->model_ms : nullptr);
+}
+
+Status Simulation::rebuildGeometry(PassRecord* timing) {
+  PassTimer timer;
 
   // Surface for contact and rendering: boundary faces, compacted vertex numbering.
   Eigen::VectorXi face_tet;
@@ -558,16 +576,22 @@ void Simulation::finishPass() {
   }
   timer.lap(&rec.remap_ms);
 
+  // Anchors of the new mesh: surviving nodes that did not move keep theirs.
+  std::vector<std::uint8_t> anchored_after(static_cast<size_t>(n), 0);
+  for (int i = 0; i < static_cast<int>(change.node_old_to_new.size()); ++i) {
+    const int j = change.node_old_to_new[i];
+    if (j >= 0 && i < static_cast<int>(anchored_.size())) anchored_after[j] = anchored_[i];
+  }
+  auto reanchor = [&](int j) {
+    if (j >= 0 && j < n) anchored_after[j] = isAnchored(rest.row(j).transpose()) ? 1 : 0;
+  };
+  for (const cutting::NewNode& nn : change.new_nodes) reanchor(nn.id);
+  for (int j : change.moved_nodes) reanchor(j);
+  for (int j : change.cut_nodes) reanchor(j);
   // Chips: pieces connected to no anchored node are removed (their volume is resected).
   std::vector<int> anchored;
-  for (int i = 0; i < n; ++i) {
-    for (const AnchorRegion& a : scene_.anchors) {
-      if (a.contains(rest.row(i).transpose())) {
-        anchored.push_back(i);
-        break;
-      }
-    }
-  }
+  for (int i = 0; i < n; ++i)
+    if (anchored_after[i]) anchored.push_back(i);
   const cutting::Components3D comps = cutting::tetComponents(after, anchored);
   int myoma_label = -1;
   for (const sim::Material& m : scene_.materials) {
@@ -586,19 +610,23 @@ void Simulation::finishPass() {
   }
   for (int c = 0; c < comps.count; ++c) rec.chips += comps.free[c] ? 1 : 0;
   rec.components = comps.count;
-  std::vector<int> new_index(n, -1);
-  int kept_nodes = 0;
+  // The kept nodes, renumbered in their order (so the model's arrays compact in place).
+  std::vector<std::int32_t> new_index(n, -1);
   for (int t : keep_tets)
-    for (int k = 0; k < 4; ++k)
-      if (new_index[after.T(t, k)] < 0) new_index[after.T(t, k)] = kept_nodes++;
+    for (int k = 0; k < 4; ++k) new_index[after.T(t, k)] = 0;
+  int kept_nodes = 0;
+  for (int i = 0; i < n; ++i)
+    if (new_index[i] == 0) new_index[i] = kept_nodes++;
   cutting::TetMesh rest_mesh;
   rest_mesh.X.resize(kept_nodes, 3);
   sim::NodeVectors x_kept(kept_nodes, 3), v_kept(kept_nodes, 3);
+  std::vector<std::uint8_t> anchored_kept(static_cast<size_t>(kept_nodes), 0);
   for (int i = 0; i < n; ++i) {
     if (new_index[i] < 0) continue;
     rest_mesh.X.row(new_index[i]) = rest.row(i);
     x_kept.row(new_index[i]) = xnew.row(i);
     v_kept.row(new_index[i]) = v.row(i);
+    anchored_kept[new_index[i]] = anchored_after[i];
   }
   rest_mesh.T.resize(static_cast<Eigen::Index>(keep_tets.size()), 4);
   rest_mesh.material.resize(static_cast<Eigen::Index>(keep_tets.size()));
@@ -634,7 +662,21 @@ void Simulation::finishPass() {
     chip_shapes = chipShapes(deformed, v, comps, on_cut, scene_.materials, myoma_label);
   }
   timer.lap(&rec.chips_ms);
-  if (Status st = setTopology(std::move(rest_mesh), &x_kept, &v_kept, &rec); !st.ok()) return fail(st.error());
+  // The tissue model, updated around the cut (moment-preserving masses, Van Gelder springs,
+  // stability estimate near the cut); the chips leave with their masses.
+  sim::CutUpdate3DReport update;
+  if (Status st = sim::updateModelAfterCut3D(model_, mesh_, after, change, anchored_after, new_index, {}, &update);
+      !st.ok()) {
+    return fail(st.error());
+  }
+  mesh_ = std::move(rest_mesh);
+  anchored_ = std::move(anchored_kept);
+  resetState(&x_kept, &v_kept);
+  if (std::getenv("HYSIM_DEBUG_UPDATE")) std::fprintf(stderr, "update: touched %d unknowns %d clamped %d resid %.2e springs %d stab %d steps %d global %d omega_prev %.1f local %.1f\n", update.touched_nodes, update.masses.unknowns, update.masses.clamped, update.masses.moment_residual, update.springs_recomputed, update.stability_nodes, update.lanczos_steps, int(update.global_stability), update.omega_previous, update.omega_local);
+  rec.stability_nodes = update.stability_nodes;
+  rec.global_stability = update.global_stability;
+  timer.lap(&rec.model_ms);
+  if (Status st = rebuildGeometry(&rec); !st.ok()) return fail(st.error());
   timer.lap(nullptr);
   for (const ChipShape& chip : chip_shapes) chips_->addChip(chip);  // after the cavity is rebuilt
   timer.lap(&rec.chips_ms);

@@ -41,7 +41,9 @@ struct PassRecord {
   int crossed_edges = 0, snapped_nodes = 0, split_edges = 0, duplicated_nodes = 0, cut_faces = 0;
   int components = 0;
   int substeps = 0;          // of the rebuilt model
-  double added_mass_g = 0.0; // mass scaling needed to keep substeps within the cap
+  double added_mass_g = 0.0; // mass scaling needed to keep substeps within the cap (since the start)
+  int stability_nodes = 0;   // free nodes of the model update's frequency estimate
+  bool global_stability = false;  // that estimate covered the whole mesh (the highest mode was near the cut)
   bool cut_failed = false;   // the cut was refused (the mesh is left as it was)
   std::string message;
 };
@@ -122,6 +124,13 @@ class Simulation {
   // wall time of the parts (model_ms, surface_ms, collision_ms, locator_ms, chips_ms).
   Status setTopology(cutting::TetMesh rest_mesh, const sim::NodeVectors* x, const sim::NodeVectors* v,
                      PassRecord* timing = nullptr);
+  // Everything built from mesh_ and state_.x for contact, collision and drawing: boundary
+  // faces, render surface, contact nodes, FCL hierarchy, tet locator, chips' cavity.
+  Status rebuildGeometry(PassRecord* timing);
+  // State for model_ and mesh_ with positions x and velocities v (null: rest, zero), keeping
+  // the step count, time and warnings; counts anchored and deformable elements.
+  void resetState(const sim::NodeVectors* x, const sim::NodeVectors* v);
+  bool isAnchored(const Eigen::Vector3d& rest) const;
   // Does the loop touch the tissue this step? Its sweep since the last step against the
   // boundary (FCL), else whether the wire is buried (one point in a tet).
   bool loopTouchesTissue();
@@ -166,6 +175,7 @@ class Simulation {
   int topology_version_ = 0;
   std::vector<PassRecord> passes_;
   std::vector<std::uint8_t> on_cut_;  // #N: node lies on a cut surface (drawn as cut tissue)
+  std::vector<std::uint8_t> anchored_;  // #N: rest position in an anchor region (fixed)
   double initial_myoma_mm3_ = 0.0;
   double electrode_active_s_ = 0.0;
   double path_length_mm_ = 0.0;
