@@ -6,8 +6,6 @@
 #include <algorithm>
 #include <assimp/Importer.hpp>
 #include <chrono>
-#include <cstdio>
-#include <cstdlib>
 #include <cmath>
 #include <limits>
 
@@ -672,7 +670,6 @@ void Simulation::finishPass() {
   mesh_ = std::move(rest_mesh);
   anchored_ = std::move(anchored_kept);
   resetState(&x_kept, &v_kept);
-  if (std::getenv("HYSIM_DEBUG_UPDATE")) std::fprintf(stderr, "update: touched %d unknowns %d clamped %d resid %.2e springs %d stab %d steps %d global %d omega_prev %.1f local %.1f\n", update.touched_nodes, update.masses.unknowns, update.masses.clamped, update.masses.moment_residual, update.springs_recomputed, update.stability_nodes, update.lanczos_steps, int(update.global_stability), update.omega_previous, update.omega_local);
   rec.stability_nodes = update.stability_nodes;
   rec.global_stability = update.global_stability;
   timer.lap(&rec.model_ms);

@@ -1,6 +1,7 @@
 // Incremental model update after a 3D cut (updateModelAfterCut3D, see tissue_update3d.hpp).
 #include <Eigen/Dense>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <string>
 
@@ -206,17 +207,47 @@ Status updateModelAfterCut3D(Model& model, const cutting::TetMesh& before, const
     if (nn.id >= 0 && nn.id < N1) touched[nn.id] = 1;
   for (int i : change.cut_nodes)
     if (i >= 0 && i < N1) touched[i] = 1;
+  // Elements that are not an old element with the same nodes (added, or renumbered onto a
+  // duplicate by the cut) touch their nodes, and so do the old elements they replace.
+  const int T0 = before.numTets();
+  if (static_cast<int>(change.element_old_to_new.size()) != T0)
+    return Error{"updateModelAfterCut3D: the change's element map does not match the mesh"};
+  std::vector<int> old_of(static_cast<size_t>(T1), -1);
+  for (int t = 0; t < T0; ++t) {
+    const int u = change.element_old_to_new[t];
+    if (u >= 0 && u < T1) old_of[u] = t;
+  }
+  auto touchOld = [&](int t) {
+    for (int k = 0; k < 4; ++k) {
+      const int j = o2n[before.T(t, k)];
+      if (j >= 0) touched[j] = 1;
+    }
+  };
+  for (int t = 0; t < T0; ++t)
+    if (change.element_old_to_new[t] < 0) touchOld(t);
+  for (int t = 0; t < T1; ++t) {
+    const int o = old_of[t];
+    bool same = o >= 0;
+    if (same) {
+      std::array<int, 4> a{}, b{};
+      for (int k = 0; k < 4; ++k) {
+        a[k] = after.T(t, k);
+        b[k] = o2n[before.T(o, k)];
+      }
+      std::sort(a.begin(), a.end());
+      std::sort(b.begin(), b.end());
+      same = a == b;
+    }
+    if (!same) {
+      touchTet(t);
+      if (o >= 0) touchOld(o);
+    }
+  }
   for (int t : change.added_elements)
     if (t >= 0 && t < T1) touchTet(t);
   for (int i : change.moved_nodes)
     if (i >= 0 && i < N1)
       for (int e = off[i]; e < off[i + 1]; ++e) touchTet(around[e]);  // their volumes changed
-  for (int t : change.removed_elements)
-    if (t >= 0 && t < before.numTets())
-      for (int k = 0; k < 4; ++k) {
-        const int j = o2n[before.T(t, k)];
-        if (j >= 0) touched[j] = 1;
-      }
   std::vector<int> region_nodes;
   for (int i = 0; i < N1; ++i)
     if (touched[i]) region_nodes.push_back(i);
