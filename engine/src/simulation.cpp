@@ -165,7 +165,14 @@ Status Simulation::setTopology(cutting::TetMesh rest_mesh, const sim::NodeVector
   model_ = std::move(model.value());
   resetState(x, v);
   timer.lap(timing ? &timing->model_ms : nullptr);
+  tet_quality_.resize(static_cast<size_t>(mesh_.numTets()));
+  for (int t = 0; t < mesh_.numTets(); ++t) tet_quality_[t] = tetQuality(mesh_, t);
   return rebuildGeometry(timing);
+}
+
+double Simulation::tetQuality(const cutting::TetMesh& mesh, int t) {
+  return cutting::radiusRatio(mesh.X.row(mesh.T(t, 0)).transpose(), mesh.X.row(mesh.T(t, 1)).transpose(),
+                              mesh.X.row(mesh.T(t, 2)).transpose(), mesh.X.row(mesh.T(t, 3)).transpose());
 }
 
 bool Simulation::isAnchored(const Eigen::Vector3d& rest) const {
@@ -667,6 +674,7 @@ void Simulation::finishPass() {
       !st.ok()) {
     return fail(st.error());
   }
+  const cutting::TetMesh previous = std::move(mesh_);
   mesh_ = std::move(rest_mesh);
   anchored_ = std::move(anchored_kept);
   resetState(&x_kept, &v_kept);
@@ -677,11 +685,34 @@ void Simulation::finishPass() {
   timer.lap(nullptr);
   for (const ChipShape& chip : chip_shapes) chips_->addChip(chip);  // after the cavity is rebuilt
   timer.lap(&rec.chips_ms);
-  const cutting::MeshStats stats = cutting::computeStats(mesh_);
+  // q_min: each element's quality is kept from the previous pass unless the element is new,
+  // renumbered onto other nodes, or has a node the cut moved.
+  {
+    std::vector<double> quality(static_cast<size_t>(mesh_.numTets()));
+    std::vector<int> old_of(static_cast<size_t>(after.numTets()), -1);
+    for (int t = 0; t < static_cast<int>(change.element_old_to_new.size()); ++t) {
+      const int u = change.element_old_to_new[t];
+      if (u >= 0 && u < after.numTets()) old_of[u] = t;
+    }
+    std::vector<std::uint8_t> moved(static_cast<size_t>(n), 0);
+    for (int j : change.moved_nodes)
+      if (j >= 0 && j < n) moved[j] = 1;
+    rec.q_min = std::numeric_limits<double>::infinity();
+    for (size_t k = 0; k < keep_tets.size(); ++k) {
+      const int t = keep_tets[k], o = old_of[t];
+      bool same = o >= 0 && o < static_cast<int>(tet_quality_.size());
+      for (int c = 0; c < 4 && same; ++c) {
+        const int node = after.T(t, c);
+        same = !moved[node] && change.node_old_to_new[previous.T(o, c)] == node;
+      }
+      quality[k] = same ? tet_quality_[o] : tetQuality(mesh_, static_cast<int>(k));
+      rec.q_min = std::min(rec.q_min, quality[k]);
+    }
+    tet_quality_ = std::move(quality);
+  }
   timer.lap(&rec.stats_ms);
   rec.elements = mesh_.numTets();
   rec.nodes = mesh_.numNodes();
-  rec.q_min = stats.q_min;
   rec.substeps = model_.substeps;
   rec.added_mass_g = model_.added_mass;
   rec.cut_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();

@@ -131,6 +131,7 @@ class Simulation {
   // the step count, time and warnings; counts anchored and deformable elements.
   void resetState(const sim::NodeVectors* x, const sim::NodeVectors* v);
   bool isAnchored(const Eigen::Vector3d& rest) const;
+  static double tetQuality(const cutting::TetMesh& mesh, int t);  // q* = r_in / R_circ, rest shape
   // Does the loop touch the tissue this step? Its sweep since the last step against the
   // boundary (FCL), else whether the wire is buried (one point in a tet).
   bool loopTouchesTissue();
@@ -176,6 +177,7 @@ class Simulation {
   std::vector<PassRecord> passes_;
   std::vector<std::uint8_t> on_cut_;  // #N: node lies on a cut surface (drawn as cut tissue)
   std::vector<std::uint8_t> anchored_;  // #N: rest position in an anchor region (fixed)
+  std::vector<double> tet_quality_;     // #T: q* of each element (rest shape), for q_min
   double initial_myoma_mm3_ = 0.0;
   double electrode_active_s_ = 0.0;
   double path_length_mm_ = 0.0;
