@@ -153,6 +153,10 @@ std::string reportJson(const RunReport& r) {
     e["nodes"] = p.nodes;
     e["q_min"] = p.q_min;
     e["cut_ms"] = p.cut_ms;
+    e["cut_parts_ms"] = {{"map", p.map_ms},           {"cut3d", p.cut3d_ms},       {"remap", p.remap_ms},
+                         {"components", p.components_ms}, {"model", p.model_ms},   {"surface", p.surface_ms},
+                         {"collision", p.collision_ms}, {"locator", p.locator_ms}, {"chips", p.chips_ms},
+                         {"stats", p.stats_ms},         {"other", p.other_ms}};
     e["chips"] = p.chips;
     e["removed_mm3"] = p.removed_mm3;
     e["removed_myoma_mm3"] = p.removed_myoma_mm3;
@@ -165,6 +169,8 @@ std::string reportJson(const RunReport& r) {
     e["components"] = p.components;
     e["substeps"] = p.substeps;
     e["added_mass_g"] = p.added_mass_g;
+    e["stability_nodes"] = p.stability_nodes;
+    e["global_stability"] = p.global_stability;
     if (p.cut_failed) e["failed"] = p.message;
     per_pass.push_back(e);
   }

@@ -12,6 +12,7 @@
 #include "hysim/cutting/cut3d.hpp"
 #include "hysim/cutting/mesh_io.hpp"
 #include "hysim/cutting/mesh_stats.hpp"
+#include "hysim/sim/tissue_update3d.hpp"
 
 namespace hysim::engine {
 namespace {
@@ -102,6 +103,20 @@ std::vector<ChipShape> chipShapes(const cutting::TetMesh& after, const sim::Node
   return out;
 }
 
+// Wall time of the parts of a pass (measurement only: nothing simulated depends on it).
+// lap(&field) adds the time since the previous lap to field.
+class PassTimer {
+ public:
+  void lap(double* into) {
+    const auto now = std::chrono::steady_clock::now();
+    if (into != nullptr) *into += std::chrono::duration<double, std::milli>(now - last_).count();
+    last_ = now;
+  }
+
+ private:
+  std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
+};
+
 }  // namespace
 
 Result<render::SurfaceMesh> loadSurface(const std::string& path, render::SurfaceMaterial material) {
@@ -133,22 +148,41 @@ Result<render::SurfaceMesh> loadSurface(const std::string& path, render::Surface
   return out;
 }
 
-Status Simulation::setTopology(cutting::TetMesh rest_mesh, const sim::NodeVectors* x, const sim::NodeVectors* v) {
+Status Simulation::setTopology(cutting::TetMesh rest_mesh, const sim::NodeVectors* x, const sim::NodeVectors* v,
+                               PassRecord* timing) {
+  PassTimer timer;
   mesh_ = std::move(rest_mesh);
   std::vector<int> fixed;
+  anchored_.assign(static_cast<size_t>(mesh_.numNodes()), 0);
   for (int i = 0; i < mesh_.numNodes(); ++i) {
-    const Eigen::Vector3d p = mesh_.X.row(i).transpose();
-    for (const AnchorRegion& a : scene_.anchors) {
-      if (a.contains(p)) {
-        fixed.push_back(i);
-        break;
-      }
+    if (isAnchored(mesh_.X.row(i).transpose())) {
+      anchored_[i] = 1;
+      fixed.push_back(i);
     }
   }
-  num_anchored_ = static_cast<int>(fixed.size());
   auto model = sim::buildModel(mesh_, scene_.materials, fixed, scene_.sim);
   if (!model.ok()) return Error{model.error()};
   model_ = std::move(model.value());
+  resetState(x, v);
+  timer.lap(timing ? &timing->model_ms : nullptr);
+  tet_quality_.resize(static_cast<size_t>(mesh_.numTets()));
+  for (int t = 0; t < mesh_.numTets(); ++t) tet_quality_[t] = tetQuality(mesh_, t);
+  return rebuildGeometry(timing);
+}
+
+double Simulation::tetQuality(const cutting::TetMesh& mesh, int t) {
+  return cutting::radiusRatio(mesh.X.row(mesh.T(t, 0)).transpose(), mesh.X.row(mesh.T(t, 1)).transpose(),
+                              mesh.X.row(mesh.T(t, 2)).transpose(), mesh.X.row(mesh.T(t, 3)).transpose());
+}
+
+bool Simulation::isAnchored(const Eigen::Vector3d& rest) const {
+  for (const AnchorRegion& a : scene_.anchors) {
+    if (a.contains(rest)) return true;
+  }
+  return false;
+}
+
+void Simulation::resetState(const sim::NodeVectors* x, const sim::NodeVectors* v) {
   const int warnings = state_.warnings;
   const std::uint64_t steps = state_.steps;
   const double time = state_.time;
@@ -158,12 +192,18 @@ Status Simulation::setTopology(cutting::TetMesh rest_mesh, const sim::NodeVector
   state_.warnings = warnings;
   state_.steps = steps;
   state_.time = time;
+  num_anchored_ = 0;
+  for (std::uint8_t a : anchored_) num_anchored_ += a;
   num_deformable_tets_ = 0;
   for (int t = 0; t < mesh_.numTets(); ++t) {
     bool moves = false;
     for (int c = 0; c < 4; ++c) moves = moves || !model_.fixed[mesh_.T(t, c)];
     num_deformable_tets_ += moves ? 1 : 0;
   }
+}
+
+Status Simulation::rebuildGeometry(PassRecord* timing) {
+  PassTimer timer;
 
   // Surface for contact and rendering: boundary faces, compacted vertex numbering.
   Eigen::VectorXi face_tet;
@@ -202,13 +242,17 @@ Status Simulation::setTopology(cutting::TetMesh rest_mesh, const sim::NodeVector
     if (!model_.fixed[node]) contact_nodes_.push_back(node);
   }
   contact_force_ = sim::NodeVectors::Zero(mesh_.numNodes(), 3);
+  timer.lap(timing ? &timing->surface_ms : nullptr);
   // The boundary's hierarchy, with boxes grown by half a millimetre: while the tissue near
   // the loop moves less than that, a step only moves the vertices (see collision.hpp).
   if (Status st = collision_.build(surface_faces_, state_.x, 0.5); !st.ok()) return st;
   collision_active_ = true;  // just fitted
   buried_known_ = false;
+  timer.lap(timing ? &timing->collision_ms : nullptr);
   locator_.build(mesh_, state_.x);
+  timer.lap(timing ? &timing->locator_ms : nullptr);
   if (chips_) chips_->setCavity(state_.x, surface_faces_);
+  timer.lap(timing ? &timing->chips_ms : nullptr);
   ++topology_version_;
   return Status::Ok();
 }
@@ -422,6 +466,7 @@ void Simulation::checkPerforation() {
 void Simulation::finishPass() {
   using Clock = std::chrono::steady_clock;
   const auto t0 = Clock::now();
+  PassTimer timer;
   cutting_ = false;
   PassRecord rec;
   rec.time_s = state_.time;
@@ -500,10 +545,12 @@ void Simulation::finishPass() {
     }
   auto surface = cutting::CutSurface::triangles(rv, rf);
   if (!surface.ok()) return fail(surface.error());
+  timer.lap(&rec.map_ms);
   cutting::Cut3DOptions options;
   options.method = cutting::CutMethod::Hybrid;
   auto cut = cutting::cut3d(mesh_, *surface, options);
   if (!cut.ok()) return fail(cut.error());
+  timer.lap(&rec.cut3d_ms);
   const cutting::TopologyChange& change = cut->change;
   rec.crossed_edges = cut->report.crossed_edges;
   rec.snapped_nodes = cut->report.snapped_nodes;
@@ -537,17 +584,24 @@ void Simulation::finishPass() {
     v.row(nn.id) = vel;
     known[nn.id] = 1;
   }
+  timer.lap(&rec.remap_ms);
 
+  // Anchors of the new mesh: surviving nodes that did not move keep theirs.
+  std::vector<std::uint8_t> anchored_after(static_cast<size_t>(n), 0);
+  for (int i = 0; i < static_cast<int>(change.node_old_to_new.size()); ++i) {
+    const int j = change.node_old_to_new[i];
+    if (j >= 0 && i < static_cast<int>(anchored_.size())) anchored_after[j] = anchored_[i];
+  }
+  auto reanchor = [&](int j) {
+    if (j >= 0 && j < n) anchored_after[j] = isAnchored(rest.row(j).transpose()) ? 1 : 0;
+  };
+  for (const cutting::NewNode& nn : change.new_nodes) reanchor(nn.id);
+  for (int j : change.moved_nodes) reanchor(j);
+  for (int j : change.cut_nodes) reanchor(j);
   // Chips: pieces connected to no anchored node are removed (their volume is resected).
   std::vector<int> anchored;
-  for (int i = 0; i < n; ++i) {
-    for (const AnchorRegion& a : scene_.anchors) {
-      if (a.contains(rest.row(i).transpose())) {
-        anchored.push_back(i);
-        break;
-      }
-    }
-  }
+  for (int i = 0; i < n; ++i)
+    if (anchored_after[i]) anchored.push_back(i);
   const cutting::Components3D comps = cutting::tetComponents(after, anchored);
   int myoma_label = -1;
   for (const sim::Material& m : scene_.materials) {
@@ -566,19 +620,23 @@ void Simulation::finishPass() {
   }
   for (int c = 0; c < comps.count; ++c) rec.chips += comps.free[c] ? 1 : 0;
   rec.components = comps.count;
-  std::vector<int> new_index(n, -1);
-  int kept_nodes = 0;
+  // The kept nodes, renumbered in their order (so the model's arrays compact in place).
+  std::vector<std::int32_t> new_index(n, -1);
   for (int t : keep_tets)
-    for (int k = 0; k < 4; ++k)
-      if (new_index[after.T(t, k)] < 0) new_index[after.T(t, k)] = kept_nodes++;
+    for (int k = 0; k < 4; ++k) new_index[after.T(t, k)] = 0;
+  int kept_nodes = 0;
+  for (int i = 0; i < n; ++i)
+    if (new_index[i] == 0) new_index[i] = kept_nodes++;
   cutting::TetMesh rest_mesh;
   rest_mesh.X.resize(kept_nodes, 3);
   sim::NodeVectors x_kept(kept_nodes, 3), v_kept(kept_nodes, 3);
+  std::vector<std::uint8_t> anchored_kept(static_cast<size_t>(kept_nodes), 0);
   for (int i = 0; i < n; ++i) {
     if (new_index[i] < 0) continue;
     rest_mesh.X.row(new_index[i]) = rest.row(i);
     x_kept.row(new_index[i]) = xnew.row(i);
     v_kept.row(new_index[i]) = v.row(i);
+    anchored_kept[new_index[i]] = anchored_after[i];
   }
   rest_mesh.T.resize(static_cast<Eigen::Index>(keep_tets.size()), 4);
   rest_mesh.material.resize(static_cast<Eigen::Index>(keep_tets.size()));
@@ -606,21 +664,66 @@ void Simulation::finishPass() {
     if (j >= 0 && j < n) old_to_kept[i] = new_index[j];
   }
   outer_wall_.remapNodes(old_to_kept);
+  timer.lap(&rec.components_ms);
   std::vector<ChipShape> chip_shapes;
   if (chips_) {
     cutting::TetMesh deformed = after;  // chips start where the pieces are now
     deformed.X = xnew;
     chip_shapes = chipShapes(deformed, v, comps, on_cut, scene_.materials, myoma_label);
   }
-  if (Status st = setTopology(std::move(rest_mesh), &x_kept, &v_kept); !st.ok()) return fail(st.error());
+  timer.lap(&rec.chips_ms);
+  // The tissue model, updated around the cut (moment-preserving masses, Van Gelder springs,
+  // stability estimate near the cut); the chips leave with their masses.
+  sim::CutUpdate3DReport update;
+  if (Status st = sim::updateModelAfterCut3D(model_, mesh_, after, change, anchored_after, new_index, {}, &update);
+      !st.ok()) {
+    return fail(st.error());
+  }
+  const cutting::TetMesh previous = std::move(mesh_);
+  mesh_ = std::move(rest_mesh);
+  anchored_ = std::move(anchored_kept);
+  resetState(&x_kept, &v_kept);
+  rec.stability_nodes = update.stability_nodes;
+  rec.global_stability = update.global_stability;
+  timer.lap(&rec.model_ms);
+  if (Status st = rebuildGeometry(&rec); !st.ok()) return fail(st.error());
+  timer.lap(nullptr);
   for (const ChipShape& chip : chip_shapes) chips_->addChip(chip);  // after the cavity is rebuilt
-  const cutting::MeshStats stats = cutting::computeStats(mesh_);
+  timer.lap(&rec.chips_ms);
+  // q_min: each element's quality is kept from the previous pass unless the element is new,
+  // renumbered onto other nodes, or has a node the cut moved.
+  {
+    std::vector<double> quality(static_cast<size_t>(mesh_.numTets()));
+    std::vector<int> old_of(static_cast<size_t>(after.numTets()), -1);
+    for (int t = 0; t < static_cast<int>(change.element_old_to_new.size()); ++t) {
+      const int u = change.element_old_to_new[t];
+      if (u >= 0 && u < after.numTets()) old_of[u] = t;
+    }
+    std::vector<std::uint8_t> moved(static_cast<size_t>(n), 0);
+    for (int j : change.moved_nodes)
+      if (j >= 0 && j < n) moved[j] = 1;
+    rec.q_min = std::numeric_limits<double>::infinity();
+    for (size_t k = 0; k < keep_tets.size(); ++k) {
+      const int t = keep_tets[k], o = old_of[t];
+      bool same = o >= 0 && o < static_cast<int>(tet_quality_.size());
+      for (int c = 0; c < 4 && same; ++c) {
+        const int node = after.T(t, c);
+        same = !moved[node] && change.node_old_to_new[previous.T(o, c)] == node;
+      }
+      quality[k] = same ? tet_quality_[o] : tetQuality(mesh_, static_cast<int>(k));
+      rec.q_min = std::min(rec.q_min, quality[k]);
+    }
+    tet_quality_ = std::move(quality);
+  }
+  timer.lap(&rec.stats_ms);
   rec.elements = mesh_.numTets();
   rec.nodes = mesh_.numNodes();
-  rec.q_min = stats.q_min;
   rec.substeps = model_.substeps;
   rec.added_mass_g = model_.added_mass;
   rec.cut_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+  rec.other_ms = std::max(0.0, rec.cut_ms - (rec.map_ms + rec.cut3d_ms + rec.remap_ms + rec.components_ms + rec.model_ms +
+                                             rec.surface_ms + rec.collision_ms + rec.locator_ms + rec.chips_ms +
+                                             rec.stats_ms));
   passes_.push_back(rec);
 }
 

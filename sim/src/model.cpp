@@ -5,6 +5,7 @@
 
 #include "hysim/sim/model.hpp"
 #include "implicit_solver.hpp"
+#include "model_internal.hpp"
 
 namespace hysim::sim {
 namespace {
@@ -16,7 +17,7 @@ constexpr int kTetEdges[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}}
 
 // Highest natural frequency of the linearised spring network (springs along their rest
 // directions), by power iteration on M^-1/2 K M^-1/2 over free nodes. Deterministic start.
-double estimateOmegaMax(const Model& m, const cutting::Positions& X) {
+double estimateOmegaMax(const Model& m, const cutting::Positions& X, Eigen::MatrixX3d* mode = nullptr) {
   const int n = m.num_nodes;
   Eigen::MatrixX3d u = Eigen::MatrixX3d::Zero(n, 3), w(n, 3);
   for (int i = 0; i < n; ++i) {
@@ -44,6 +45,7 @@ double estimateOmegaMax(const Model& m, const cutting::Positions& X) {
     }
     // w = -M^-1/2 K M^-1/2 u ; Rayleigh quotient of K-tilde
     const double next = -(u.array() * w.array()).sum();
+    if (mode != nullptr) *mode = u;  // the unit vector whose Rayleigh quotient is `next`
     u = -w;
     if (iter > 60 && std::abs(next - lambda) <= 1e-5 * next) {
       lambda = next;
@@ -55,6 +57,40 @@ double estimateOmegaMax(const Model& m, const cutting::Positions& X) {
 }
 
 }  // namespace
+
+void buildStepSprings(Model& m) {
+  // A spring between two anchored nodes never changes length: the step skips it.
+  const int n = m.num_nodes;
+  const int ns = static_cast<int>(m.springs.rows());
+  StepSprings& st = m.step_springs;
+  st.a.clear();
+  st.b.clear();
+  st.rest_length.clear();
+  st.stiffness.clear();
+  st.damping.clear();
+  st.node_offset.assign(n + 1, 0);
+  for (int s = 0; s < ns; ++s) {
+    const int a = m.springs(s, 0), b = m.springs(s, 1);
+    if (m.fixed[a] && m.fixed[b]) continue;
+    st.a.push_back(a);
+    st.b.push_back(b);
+    st.rest_length.push_back(m.rest_length[s]);
+    st.stiffness.push_back(m.stiffness[s]);
+    st.damping.push_back(m.damping[s]);
+    ++st.node_offset[a + 1];
+    ++st.node_offset[b + 1];
+  }
+  for (int i = 0; i < n; ++i) st.node_offset[i + 1] += st.node_offset[i];
+  st.incident.resize(st.node_offset[n]);
+  st.sign.resize(st.node_offset[n]);
+  std::vector<int> fill(st.node_offset.begin(), st.node_offset.end() - 1);
+  for (int k = 0; k < st.size(); ++k) {
+    st.incident[fill[st.a[k]]] = k;
+    st.sign[fill[st.a[k]]++] = 1.0;
+    st.incident[fill[st.b[k]]] = k;
+    st.sign[fill[st.b[k]]++] = -1.0;
+  }
+}
 
 Result<Model> buildModel(const TetMesh& mesh, const std::vector<Material>& materials,
                          const std::vector<int>& fixed_nodes, const ModelOptions& options) {
@@ -143,32 +179,7 @@ Result<Model> buildModel(const TetMesh& mesh, const std::vector<Material>& mater
     if (m.mass[i] <= 0.0) m.fixed[i] = 1;
     if (!m.fixed[i]) m.inv_mass[i] = 1.0 / m.mass[i];
   }
-  // A spring between two anchored nodes never changes length: the step skips it.
-  StepSprings& st = m.step_springs;
-  st = StepSprings{};
-  std::vector<int> degree(n, 0);
-  for (int s = 0; s < ns; ++s) {
-    const int a = m.springs(s, 0), b = m.springs(s, 1);
-    if (m.fixed[a] && m.fixed[b]) continue;
-    st.a.push_back(a);
-    st.b.push_back(b);
-    st.rest_length.push_back(m.rest_length[s]);
-    st.stiffness.push_back(m.stiffness[s]);
-    st.damping.push_back(m.damping[s]);
-    ++degree[a];
-    ++degree[b];
-  }
-  st.node_offset.assign(n + 1, 0);
-  for (int i = 0; i < n; ++i) st.node_offset[i + 1] = st.node_offset[i] + degree[i];
-  st.incident.resize(st.node_offset[n]);
-  st.sign.resize(st.node_offset[n]);
-  std::vector<int> fill(st.node_offset.begin(), st.node_offset.end() - 1);
-  for (int k = 0; k < st.size(); ++k) {
-    st.incident[fill[st.a[k]]] = k;
-    st.sign[fill[st.a[k]]++] = 1.0;
-    st.incident[fill[st.b[k]]] = k;
-    st.sign[fill[st.b[k]]++] = -1.0;
-  }
+  buildStepSprings(m);
 
   // Stability of symplectic Euler with stiffness damping (zeta = beta*omega/2):
   // omega*h < 2*(sqrt(1+zeta^2) - zeta).
@@ -182,7 +193,7 @@ Result<Model> buildModel(const TetMesh& mesh, const std::vector<Material>& mater
   auto substepsFor = [&](double critical) {
     return std::max(1, static_cast<int>(std::ceil(options.dt / (options.stability_safety * critical))));
   };
-  m.omega_max = estimateOmegaMax(m, mesh.X);
+  m.omega_max = estimateOmegaMax(m, mesh.X, &m.stability_mode);
   m.critical_dt = stabilityLimit(m.omega_max);
 
   // Selective mass scaling (as explicit FE codes do): a few tiny elements (slivers from a
@@ -208,7 +219,7 @@ Result<Model> buildModel(const TetMesh& mesh, const std::vector<Material>& mater
           m.inv_mass[i] = 1.0 / needed;
         }
       }
-      m.omega_max = estimateOmegaMax(m, mesh.X);
+      m.omega_max = estimateOmegaMax(m, mesh.X, &m.stability_mode);
       m.critical_dt = stabilityLimit(m.omega_max);
       target *= 0.7;  // the local bound is not the global one: tighten and retry
     }

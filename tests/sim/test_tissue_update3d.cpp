@@ -1,6 +1,8 @@
 // Tissue update after 3D cuts: positive masses that keep the ten moments, remapped state.
 #include <gtest/gtest.h>
 
+#include <map>
+
 #include "box_mesh.hpp"
 #include "hysim/cutting/cut3d.hpp"
 #include "hysim/sim/tissue_update3d.hpp"
@@ -92,6 +94,172 @@ TEST(TissueUpdate3D, ModelUpdateKeepsMassAndAnchors) {
   const auto comps = cutting::tetComponents(r->mesh, {0, 1, 2});
   EXPECT_EQ(comps.count, 2);
   EXPECT_EQ(std::count(comps.free.begin(), comps.free.end(), true), 1);
+}
+
+// The incremental update after a cut gives buildModel's springs (same edges, Van Gelder
+// stiffness, rest lengths) and masses that keep the moments, positive, after each of
+// several cuts, with the piece cut free removed.
+TEST(TissueUpdate3D, IncrementalUpdateMatchesARebuild) {
+  cutting::TetMesh mesh = testing::boxTetMesh(6, 6, 6, 1.0);
+  Material mat;
+  mat.label = 1;
+  mat.stiffness_damping_s = 1e-5;
+  auto anchoredAt = [](const cutting::TetMesh& m) {
+    std::vector<std::uint8_t> fixed(static_cast<size_t>(m.numNodes()), 0);
+    for (int i = 0; i < m.numNodes(); ++i) fixed[i] = m.X(i, 2) < 0.5 ? 1 : 0;
+    return fixed;
+  };
+  auto fixedList = [](const std::vector<std::uint8_t>& f) {
+    std::vector<int> out;
+    for (int i = 0; i < static_cast<int>(f.size()); ++i)
+      if (f[i]) out.push_back(i);
+    return out;
+  };
+  auto built = buildModel(mesh, {mat}, fixedList(anchoredAt(mesh)), {});
+  ASSERT_TRUE(built.ok()) << built.error();
+  Model model = *built;
+  for (int cut = 0; cut < 3; ++cut) {
+    const Vec3 point(3.0, 3.0, 4.3 - 0.8 * cut), normal(0.15 * cut, 0.2, 1.0);
+    auto r = cutting::cut3d(mesh, *cutting::CutSurface::plane(point, normal));
+    ASSERT_TRUE(r.ok()) << r.error();
+    const cutting::TetMesh& after = r->mesh;
+    // Remove the top piece (free: no anchored node), renumbering the rest in order.
+    const auto fixed_after = anchoredAt(after);
+    const auto comps = cutting::tetComponents(after, fixedList(fixed_after));
+    std::vector<std::int32_t> keep(static_cast<size_t>(after.numNodes()), -1);
+    std::vector<int> tets;
+    for (int t = 0; t < after.numTets(); ++t)
+      if (!comps.free[comps.label[t]]) {
+        tets.push_back(t);
+        for (int k = 0; k < 4; ++k) keep[after.T(t, k)] = 0;
+      }
+    int n = 0;
+    for (auto& k : keep)
+      if (k == 0) k = n++;
+    cutting::TetMesh kept;
+    kept.X.resize(n, 3);
+    for (int i = 0; i < after.numNodes(); ++i)
+      if (keep[i] >= 0) kept.X.row(keep[i]) = after.X.row(i);
+    kept.T.resize(static_cast<Eigen::Index>(tets.size()), 4);
+    kept.material.resize(static_cast<Eigen::Index>(tets.size()));
+    for (size_t k = 0; k < tets.size(); ++k) {
+      for (int c = 0; c < 4; ++c) kept.T(static_cast<Eigen::Index>(k), c) = keep[after.T(tets[k], c)];
+      kept.material[static_cast<Eigen::Index>(k)] = after.material[tets[k]];
+    }
+    // Moments the kept masses must have: the cut's moment-preserving masses on the whole
+    // cut mesh, less the removed piece.
+    const Model previous = model;
+    CutUpdate3DReport report;
+    ASSERT_TRUE(updateModelAfterCut3D(model, mesh, after, r->change, fixed_after, keep, {}, &report).ok());
+    EXPECT_LT(report.masses.moment_residual, 1e-9) << "cut " << cut;
+    EXPECT_GT(report.touched_nodes, 0);
+    ASSERT_EQ(model.num_nodes, n);
+    auto rebuilt = buildModel(kept, {mat}, fixedList(anchoredAt(kept)), {});
+    ASSERT_TRUE(rebuilt.ok());
+    ASSERT_EQ(model.springs.rows(), rebuilt->springs.rows()) << "cut " << cut;
+    std::map<std::pair<int, int>, int> index;
+    for (int s = 0; s < rebuilt->springs.rows(); ++s) index[{rebuilt->springs(s, 0), rebuilt->springs(s, 1)}] = s;
+    for (int s = 0; s < model.springs.rows(); ++s) {
+      int a = model.springs(s, 0), b = model.springs(s, 1);
+      if (a > b) std::swap(a, b);
+      ASSERT_TRUE(index.count({a, b})) << "cut " << cut << " spring " << a << "-" << b;
+      const int o = index[{a, b}];
+      EXPECT_NEAR(model.stiffness[s], rebuilt->stiffness[o], 1e-9 * rebuilt->stiffness[o]);
+      EXPECT_NEAR(model.damping[s], rebuilt->damping[o], 1e-9 * rebuilt->damping[o]);
+      EXPECT_NEAR(model.rest_length[s], rebuilt->rest_length[o], 1e-12);
+    }
+    for (int i = 0; i < n; ++i) {
+      EXPECT_EQ(model.fixed[i], rebuilt->fixed[i]);
+      EXPECT_GT(model.mass[i], 0.0);
+    }
+    // Step springs: every spring with a free end, each node's incident list complete.
+    EXPECT_EQ(model.step_springs.size(), rebuilt->step_springs.size());
+    EXPECT_EQ(model.step_springs.node_offset, rebuilt->step_springs.node_offset);
+    // Stability: the estimate near the cut (or the global one) agrees with a global
+    // estimate of the same model (nothing touched, global forced).
+    {
+      Model global = model;
+      cutting::TopologyChange identity;
+      identity.old_num_nodes = identity.new_num_nodes = n;
+      for (int i = 0; i < n; ++i) identity.node_old_to_new.push_back(i);
+      for (int t = 0; t < kept.numTets(); ++t) identity.element_old_to_new.push_back(t);
+      std::vector<std::uint8_t> flags(model.fixed.begin(), model.fixed.end());
+      CutUpdate3DOptions options;
+      options.mode_overlap = -1.0;
+      ASSERT_TRUE(updateModelAfterCut3D(global, kept, kept, identity, flags, {}, options).ok());
+      EXPECT_GT(model.omega_max, 0.97 * global.omega_max) << "cut " << cut << (report.global_stability ? " global" : " local");
+    }
+    EXPECT_GE(model.substeps, 1);
+    EXPECT_DOUBLE_EQ(model.substep * model.substeps, model.options.dt);
+    mesh = kept;
+    (void)previous;
+  }
+}
+
+// A cut that ends inside the mesh: elements on one side keep their identity but are
+// renumbered onto duplicated nodes; their edges change although some of their nodes are
+// not on the cut. The springs must still be buildModel's.
+TEST(TissueUpdate3D, IncrementalUpdateAfterAPartialCut) {
+  const cutting::TetMesh mesh = testing::boxTetMesh(6, 6, 6, 1.0);
+  Material mat;
+  mat.label = 1;
+  std::vector<std::uint8_t> flags;
+  auto built = buildModel(mesh, {mat}, {}, {});
+  ASSERT_TRUE(built.ok());
+  cutting::Positions V(4, 3);
+  V << -1, -1, 3.3, 3.4, -1, 3.35, 3.4, 7, 3.35, -1, 7, 3.3;
+  cutting::Tris F(2, 3);
+  F << 0, 1, 2, 0, 2, 3;
+  auto r = cutting::cut3d(mesh, *cutting::CutSurface::triangles(V, F));
+  ASSERT_TRUE(r.ok()) << r.error();
+  Model model = *built;
+  flags.assign(static_cast<size_t>(r->mesh.numNodes()), 0);
+  ASSERT_TRUE(updateModelAfterCut3D(model, mesh, r->mesh, r->change, flags, {}).ok());
+  auto rebuilt = buildModel(r->mesh, {mat}, {}, {});
+  ASSERT_TRUE(rebuilt.ok());
+  ASSERT_EQ(model.springs.rows(), rebuilt->springs.rows());
+  std::map<std::pair<int, int>, int> index;
+  for (int s = 0; s < rebuilt->springs.rows(); ++s) index[{rebuilt->springs(s, 0), rebuilt->springs(s, 1)}] = s;
+  for (int s = 0; s < model.springs.rows(); ++s) {
+    int a = model.springs(s, 0), b = model.springs(s, 1);
+    if (a > b) std::swap(a, b);
+    ASSERT_TRUE(index.count({a, b})) << a << "-" << b;
+    const int o = index[{a, b}];
+    EXPECT_NEAR(model.stiffness[s], rebuilt->stiffness[o], 1e-9 * model.stiffness[s]);
+  }
+  EXPECT_GT(model.mass.minCoeff(), 0.0);
+  EXPECT_NEAR(model.mass.sum(), built->mass.sum(), 1e-9 * built->mass.sum());
+}
+
+// The Lanczos estimate over the whole mesh is at least the power iteration's (no change:
+// an empty cut keeps every node; the overlap threshold < 0 forces the global estimate).
+TEST(TissueUpdate3D, LanczosEstimateReachesThePowerIteration) {
+  const cutting::TetMesh mesh = testing::boxTetMesh(6, 5, 4, 1.0);
+  Material mat;
+  mat.label = 1;
+  std::vector<int> fixed;
+  for (int i = 0; i < mesh.numNodes(); ++i)
+    if (mesh.X(i, 2) < 0.5) fixed.push_back(i);
+  auto built = buildModel(mesh, {mat}, fixed, {});
+  ASSERT_TRUE(built.ok());
+  Model model = *built;
+  cutting::TopologyChange identity;
+  identity.old_num_nodes = identity.new_num_nodes = mesh.numNodes();
+  identity.old_num_elements = identity.new_num_elements = mesh.numTets();
+  for (int i = 0; i < mesh.numNodes(); ++i) identity.node_old_to_new.push_back(i);
+  for (int t = 0; t < mesh.numTets(); ++t) identity.element_old_to_new.push_back(t);
+  std::vector<std::uint8_t> flags(static_cast<size_t>(mesh.numNodes()), 0);
+  for (int i : fixed) flags[i] = 1;
+  CutUpdate3DOptions options;
+  options.mode_overlap = -1.0;
+  CutUpdate3DReport report;
+  ASSERT_TRUE(updateModelAfterCut3D(model, mesh, mesh, identity, flags, {}, options, &report).ok());
+  EXPECT_TRUE(report.global_stability);
+  EXPECT_EQ(report.touched_nodes, 0);
+  EXPECT_GE(model.omega_max, built->omega_max * (1.0 - 1e-6));
+  EXPECT_LT(model.omega_max, built->omega_max * 1.05);
+  EXPECT_EQ(model.mass, built->mass);
+  EXPECT_EQ(model.stiffness, built->stiffness);
 }
 
 }  // namespace

@@ -26,7 +26,14 @@ struct PassRecord {
   int elements = 0;          // after the pass (chips removed)
   int nodes = 0;
   double q_min = 0.0;        // q* = r_in / R_circ of the worst tet after the pass
-  double cut_ms = 0.0;       // cut + chip removal + model rebuild
+  double cut_ms = 0.0;       // cut + chip removal + model rebuild (the whole pass, wall time)
+  // cut_ms split into its parts (wall time, ms): carrying the sweep to the rest shape,
+  // cutting::cut3d, current positions of the cut mesh, free pieces found and removed (mesh
+  // compacted), the tissue model (masses, springs, stability), boundary/render/contact
+  // arrays, the FCL hierarchy, the tet locator, chip shapes and bodies, mesh statistics;
+  // other_ms is what is left (cut_ms minus the parts).
+  double map_ms = 0.0, cut3d_ms = 0.0, remap_ms = 0.0, components_ms = 0.0, model_ms = 0.0, surface_ms = 0.0,
+         collision_ms = 0.0, locator_ms = 0.0, chips_ms = 0.0, stats_ms = 0.0, other_ms = 0.0;
   int chips = 0;             // free pieces removed
   double removed_mm3 = 0.0;  // volume of the removed chips
   double removed_myoma_mm3 = 0.0;
@@ -34,7 +41,9 @@ struct PassRecord {
   int crossed_edges = 0, snapped_nodes = 0, split_edges = 0, duplicated_nodes = 0, cut_faces = 0;
   int components = 0;
   int substeps = 0;          // of the rebuilt model
-  double added_mass_g = 0.0; // mass scaling needed to keep substeps within the cap
+  double added_mass_g = 0.0; // mass scaling needed to keep substeps within the cap (since the start)
+  int stability_nodes = 0;   // free nodes of the model update's frequency estimate
+  bool global_stability = false;  // that estimate covered the whole mesh (the highest mode was near the cut)
   bool cut_failed = false;   // the cut was refused (the mesh is left as it was)
   std::string message;
 };
@@ -111,7 +120,18 @@ class Simulation {
   void contactForces(const sim::NodeVectors& x, const sim::NodeVectors& v);
   // Replaces the mesh (rest positions) and everything built from it; x, v (#N x 3) are the
   // current positions and velocities (null: rest and zero).
-  Status setTopology(cutting::TetMesh rest_mesh, const sim::NodeVectors* x, const sim::NodeVectors* v);
+  // current positions and velocities (null: rest and zero). `timing` (optional) receives the
+  // wall time of the parts (model_ms, surface_ms, collision_ms, locator_ms, chips_ms).
+  Status setTopology(cutting::TetMesh rest_mesh, const sim::NodeVectors* x, const sim::NodeVectors* v,
+                     PassRecord* timing = nullptr);
+  // Everything built from mesh_ and state_.x for contact, collision and drawing: boundary
+  // faces, render surface, contact nodes, FCL hierarchy, tet locator, chips' cavity.
+  Status rebuildGeometry(PassRecord* timing);
+  // State for model_ and mesh_ with positions x and velocities v (null: rest, zero), keeping
+  // the step count, time and warnings; counts anchored and deformable elements.
+  void resetState(const sim::NodeVectors* x, const sim::NodeVectors* v);
+  bool isAnchored(const Eigen::Vector3d& rest) const;
+  static double tetQuality(const cutting::TetMesh& mesh, int t);  // q* = r_in / R_circ, rest shape
   // Does the loop touch the tissue this step? Its sweep since the last step against the
   // boundary (FCL), else whether the wire is buried (one point in a tet).
   bool loopTouchesTissue();
@@ -156,6 +176,8 @@ class Simulation {
   int topology_version_ = 0;
   std::vector<PassRecord> passes_;
   std::vector<std::uint8_t> on_cut_;  // #N: node lies on a cut surface (drawn as cut tissue)
+  std::vector<std::uint8_t> anchored_;  // #N: rest position in an anchor region (fixed)
+  std::vector<double> tet_quality_;     // #T: q* of each element (rest shape), for q_min
   double initial_myoma_mm3_ = 0.0;
   double electrode_active_s_ = 0.0;
   double path_length_mm_ = 0.0;

@@ -82,6 +82,10 @@ struct Model {
   double critical_dt = 0.0;        // s, estimated stability limit of symplectic Euler
   double omega_max = 0.0;          // rad/s, estimated highest natural frequency
   double added_mass = 0.0;         // g, added by selective mass scaling to respect max_substeps
+  // #N x 3: the estimate of the highest mode behind omega_max (M^1/2-scaled displacements, unit
+  // norm, zero at fixed nodes). A cut that leaves it alone leaves omega_max valid away from
+  // the cut, so the incremental update (updateModelAfterCut3D) only estimates near the cut.
+  Eigen::MatrixX3d stability_mode;
 
   std::shared_ptr<const ImplicitSolver> implicit;  // set when integrator == ImplicitEuler
 };

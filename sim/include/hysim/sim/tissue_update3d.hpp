@@ -56,4 +56,56 @@ Result<Model> updateModel3D(const Model& before, const cutting::TetMesh& mesh_be
                             const cutting::TetMesh& mesh_after, const cutting::TopologyChange& change,
                             const MassUpdate3DOptions& options = {}, MassUpdate3DReport* report = nullptr);
 
+// ---------------------------------------------------------------------------------------
+// Incremental update of a model after a cut, in place: what the simulator does after each
+// shaving pass. Same physics as updateModel3D, but only the neighbourhood of the cut is
+// recomputed; the rest is carried over by index (linear passes of plain copies):
+//  - masses: the nodes touched by the change (new, moved, on the cut, of added or removed
+//    elements, of elements with a moved node) and two rings of neighbours get their lumped
+//    mass as prior and the smallest correction that keeps the ten moments (up to second
+//    order) of the masses they replace, all positive (floor_fraction of the prior); other
+//    nodes keep their mass. The moments are those of the nodes involved, so the residual
+//    carries no round-off of the whole mesh's sums.
+//  - springs: an edge with an untouched end is unchanged (every tet around it is); edges
+//    between touched nodes are recomputed (Van Gelder k = sum_t E_t V_t / |e|^2 over the
+//    tets around them, c = sum_t beta_t E_t V_t / |e|^2), vanished ones dropped.
+//  - pieces cut free (node_to_kept[i] < 0 for their nodes, the rest renumbered by it) leave
+//    with their masses and springs.
+//  - stability: Lanczos estimate of the highest natural frequency of the free nodes near
+//    the cut (the springs to nodes outside held fixed: a principal submatrix, whose top
+//    eigenvalue is a lower bound of the whole mesh's, like the power iteration's estimate),
+//    combined with the previous omega_max when the previous highest mode (stability_mode)
+//    lies away from the cut; otherwise a Lanczos estimate over all free nodes, started from
+//    that mode. Selective mass scaling as buildModel, on the nodes near the cut.
+//  - the implicit integrator's factorisation is redone.
+struct CutUpdate3DOptions {
+  MassUpdate3DOptions masses;
+  int mass_rings = 2;               // rings of neighbours around the touched nodes
+  double mode_overlap = 0.05;       // previous mode's energy share near the cut that forces a global estimate
+  int lanczos_steps = 60;           // at most
+  int lanczos_min_steps = 20;       // at least (when the space is that large)
+  double lanczos_tolerance = 1e-3;  // relative residual of the top Ritz pair, and its growth over 5 steps
+};
+
+struct CutUpdate3DReport {
+  MassUpdate3DReport masses;      // unknowns, clamped, moment_residual (global stays false)
+  int touched_nodes = 0;          // before the rings
+  int springs_recomputed = 0;     // edges between touched nodes, recomputed
+  int stability_nodes = 0;        // free nodes of the frequency estimate
+  int lanczos_steps = 0;
+  bool global_stability = false;  // the previous mode was near the cut: estimated over all nodes
+  double omega_local = 0.0;       // rad/s, estimate near the cut
+  double omega_previous = 0.0;    // rad/s
+};
+
+// `model` belongs to `before`; afterwards it belongs to `after` with the nodes i where
+// node_to_kept[i] < 0 removed and the others renumbered to node_to_kept[i] (increasing, so
+// node order is kept; empty = keep every node). `fixed_after` (#N of after): anchored nodes.
+// Every element of `after` must have positive volume. On error the model is unchanged (but
+// for a failed factorisation of the implicit integrator, the last step).
+Status updateModelAfterCut3D(Model& model, const cutting::TetMesh& before, const cutting::TetMesh& after,
+                             const cutting::TopologyChange& change, const std::vector<std::uint8_t>& fixed_after,
+                             const std::vector<std::int32_t>& node_to_kept, const CutUpdate3DOptions& options = {},
+                             CutUpdate3DReport* report = nullptr);
+
 }  // namespace hysim::sim

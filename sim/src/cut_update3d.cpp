@@ -1,0 +1,512 @@
+// Incremental model update after a 3D cut (updateModelAfterCut3D, see tissue_update3d.hpp).
+#include <Eigen/Dense>
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <string>
+
+#include "hysim/sim/tissue_update3d.hpp"
+#include "implicit_solver.hpp"
+#include "model_internal.hpp"
+
+namespace hysim::sim {
+namespace {
+
+using Row10 = Eigen::Matrix<double, 10, 1>;
+
+Row10 monomials(const Eigen::Vector3d& p) {
+  Row10 r;
+  r << 1.0, p.x(), p.y(), p.z(), p.x() * p.x(), p.y() * p.y(), p.z() * p.z(), p.x() * p.y(), p.y() * p.z(),
+      p.z() * p.x();
+  return r;
+}
+
+// Top eigenvalue of M^-1/2 K M^-1/2 (springs linearised along their rest directions) over
+// the free nodes `nodes`, every other node held fixed (a principal submatrix), by Lanczos.
+// `start` (#N x 3, may be null or zero) is mixed into the deterministic start vector; `mode`
+// (#N x 3) receives the Ritz vector (zero outside `nodes`).
+double topEigenvalue(const Model& m, const cutting::Positions& X, const std::vector<int>& nodes,
+                     const Eigen::MatrixX3d* start, const CutUpdate3DOptions& options, Eigen::MatrixX3d* mode,
+                     int* steps_taken) {
+  const int count = static_cast<int>(nodes.size());
+  if (steps_taken) *steps_taken = 0;
+  if (count == 0) return 0.0;
+  const StepSprings& st = m.step_springs;
+  std::vector<int> local(static_cast<size_t>(m.num_nodes), -1);
+  for (int k = 0; k < count; ++k) local[nodes[k]] = k;
+  struct LocalSpring {
+    int a, b;  // local indices, -1 = held fixed
+    double dx, dy, dz, k, sa, sb;
+  };
+  std::vector<LocalSpring> springs;
+  springs.reserve(static_cast<size_t>(count) * 8);
+  for (int k = 0; k < count; ++k) {
+    const int node = nodes[k];
+    for (int e = st.node_offset[node]; e < st.node_offset[node + 1]; ++e) {
+      const int s = st.incident[e];
+      const int a = st.a[s], b = st.b[s];
+      const int other = a == node ? b : a;
+      if (local[other] >= 0 && local[other] < k) continue;  // taken at the other end
+      LocalSpring ls;
+      ls.a = m.fixed[a] ? -1 : local[a];
+      ls.b = m.fixed[b] ? -1 : local[b];
+      Eigen::RowVector3d d = X.row(b) - X.row(a);
+      d /= d.norm();
+      ls.dx = d[0];
+      ls.dy = d[1];
+      ls.dz = d[2];
+      ls.k = st.stiffness[s];
+      ls.sa = ls.a >= 0 ? 1.0 / std::sqrt(m.mass[a]) : 0.0;
+      ls.sb = ls.b >= 0 ? 1.0 / std::sqrt(m.mass[b]) : 0.0;
+      springs.push_back(ls);
+    }
+  }
+  const Eigen::Index n3 = 3 * static_cast<Eigen::Index>(count);
+  auto apply = [&](const Eigen::VectorXd& u, Eigen::VectorXd& z) {
+    z.setZero();
+    for (const LocalSpring& s : springs) {
+      double yx = 0, yy = 0, yz = 0;
+      if (s.b >= 0) {
+        yx += s.sb * u[3 * s.b];
+        yy += s.sb * u[3 * s.b + 1];
+        yz += s.sb * u[3 * s.b + 2];
+      }
+      if (s.a >= 0) {
+        yx -= s.sa * u[3 * s.a];
+        yy -= s.sa * u[3 * s.a + 1];
+        yz -= s.sa * u[3 * s.a + 2];
+      }
+      const double t = s.k * (yx * s.dx + yy * s.dy + yz * s.dz);  // (K y)_b = t d, (K y)_a = -t d
+      if (s.a >= 0) {
+        z[3 * s.a] -= s.sa * t * s.dx;
+        z[3 * s.a + 1] -= s.sa * t * s.dy;
+        z[3 * s.a + 2] -= s.sa * t * s.dz;
+      }
+      if (s.b >= 0) {
+        z[3 * s.b] += s.sb * t * s.dx;
+        z[3 * s.b + 1] += s.sb * t * s.dy;
+        z[3 * s.b + 2] += s.sb * t * s.dz;
+      }
+    }
+  };
+  // Start: the alternating pattern of buildModel's power iteration (excites the highest
+  // modes), plus the given vector.
+  Eigen::VectorXd q(n3);
+  for (int k = 0; k < count; ++k) {
+    const double s = (nodes[k] % 2 == 0) ? 1.0 : -1.0;
+    q[3 * k] = s;
+    q[3 * k + 1] = -0.5 * s;
+    q[3 * k + 2] = 0.25 * s;
+  }
+  q.normalize();
+  if (start != nullptr && start->rows() == m.num_nodes) {
+    Eigen::VectorXd w(n3);
+    for (int k = 0; k < count; ++k)
+      for (int c = 0; c < 3; ++c) w[3 * k + c] = (*start)(nodes[k], c);
+    const double norm = w.norm();
+    if (norm > 0.0) q = w / norm + 0.1 * q;
+    q.normalize();
+  }
+  const int max_steps = std::max(1, std::min(options.lanczos_steps, static_cast<int>(n3)));
+  const bool reorthogonalise = n3 <= 30000;  // cheap near a cut; not worth it over a whole mesh
+  Eigen::MatrixXd Q(n3, max_steps);
+  std::vector<double> alpha, beta, history;
+  Eigen::VectorXd z(n3);
+  double theta = 0.0;
+  Eigen::VectorXd ritz;
+  for (int j = 0; j < max_steps; ++j) {
+    Q.col(j) = q;
+    apply(q, z);
+    const double a = q.dot(z);
+    alpha.push_back(a);
+    z -= a * q;
+    if (j > 0) z -= beta.back() * Q.col(j - 1);
+    if (reorthogonalise) z -= Q.leftCols(j + 1) * (Q.leftCols(j + 1).transpose() * z);
+    const double b = z.norm();
+    const int size = j + 1;
+    Eigen::MatrixXd T = Eigen::MatrixXd::Zero(size, size);
+    for (int i = 0; i < size; ++i) {
+      T(i, i) = alpha[i];
+      if (i + 1 < size) T(i, i + 1) = T(i + 1, i) = beta[i];
+    }
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(T);
+    theta = eig.eigenvalues()[size - 1];
+    ritz = eig.eigenvectors().col(size - 1);
+    if (steps_taken) *steps_taken = size;
+    // Converged: the top Ritz pair's residual is small (theta is near *an* eigenvalue) and
+    // theta has stopped growing over the last steps (it rises towards the top one; near the
+    // top the spectrum is dense, so a small residual alone can stop below it).
+    const double residual = b * std::abs(ritz[size - 1]);
+    history.push_back(theta);
+    const bool settled = size > options.lanczos_min_steps &&
+                         theta - history[history.size() - 6] <= options.lanczos_tolerance * std::abs(theta);
+    if ((residual <= options.lanczos_tolerance * std::abs(theta) && settled) || b <= 1e-14 * std::abs(theta) ||
+        j + 1 == max_steps)
+      break;
+    beta.push_back(b);
+    q = z / b;
+  }
+  if (mode != nullptr) {
+    const Eigen::VectorXd y = Q.leftCols(ritz.size()) * ritz;
+    const double norm = y.norm();
+    mode->setZero(m.num_nodes, 3);
+    for (int k = 0; k < count; ++k)
+      for (int c = 0; c < 3; ++c) (*mode)(nodes[k], c) = norm > 0 ? y[3 * k + c] / norm : 0.0;
+  }
+  return std::max(theta, 0.0);
+}
+
+}  // namespace
+
+Status updateModelAfterCut3D(Model& model, const cutting::TetMesh& before, const cutting::TetMesh& after,
+                             const cutting::TopologyChange& change, const std::vector<std::uint8_t>& fixed_after,
+                             const std::vector<std::int32_t>& node_to_kept, const CutUpdate3DOptions& options,
+                             CutUpdate3DReport* report) {
+  const int N0 = before.numNodes(), N1 = after.numNodes(), T1 = after.numTets();
+  if (model.num_nodes != N0 || model.mass.size() != N0) return Error{"updateModelAfterCut3D: the model is not the mesh's"};
+  if (static_cast<int>(change.node_old_to_new.size()) != N0 || change.new_num_nodes != N1)
+    return Error{"updateModelAfterCut3D: the change does not match the meshes"};
+  if (static_cast<int>(fixed_after.size()) != N1) return Error{"updateModelAfterCut3D: fixed flags size differs from #N"};
+  if (!node_to_kept.empty() && static_cast<int>(node_to_kept.size()) != N1)
+    return Error{"updateModelAfterCut3D: node_to_kept size differs from #N"};
+  const std::vector<std::int32_t>& o2n = change.node_old_to_new;
+  CutUpdate3DReport rep;
+  rep.omega_previous = model.omega_max;
+
+  // Material of each tet.
+  std::vector<int> material(static_cast<size_t>(T1), -1);
+  for (int t = 0; t < T1; ++t) {
+    for (int i = 0; i < static_cast<int>(model.materials.size()); ++i)
+      if (model.materials[i].label == after.material[t]) material[t] = i;
+    if (material[t] < 0)
+      return Error{"tet " + std::to_string(t) + " has material label " + std::to_string(after.material[t]) +
+                   " but the scene defines no material with that label"};
+  }
+  // Tets around each node (CSR).
+  std::vector<int> off(static_cast<size_t>(N1) + 1, 0), around(4 * static_cast<size_t>(T1));
+  for (int t = 0; t < T1; ++t)
+    for (int k = 0; k < 4; ++k) ++off[after.T(t, k) + 1];
+  for (int i = 0; i < N1; ++i) off[i + 1] += off[i];
+  {
+    std::vector<int> fill(off.begin(), off.end() - 1);
+    for (int t = 0; t < T1; ++t)
+      for (int k = 0; k < 4; ++k) around[fill[after.T(t, k)]++] = t;
+  }
+  std::vector<double> volume(static_cast<size_t>(T1), std::nan(""));
+  auto tetVolume = [&](int t) {
+    if (std::isnan(volume[t])) volume[t] = cutting::tetVolume(after, t);
+    return volume[t];
+  };
+
+  // Touched nodes: their masses and the springs between them change.
+  std::vector<std::uint8_t> touched(static_cast<size_t>(N1), 0);
+  auto touchTet = [&](int t) {
+    for (int k = 0; k < 4; ++k) touched[after.T(t, k)] = 1;
+  };
+  for (const cutting::NewNode& nn : change.new_nodes)
+    if (nn.id >= 0 && nn.id < N1) touched[nn.id] = 1;
+  for (int i : change.cut_nodes)
+    if (i >= 0 && i < N1) touched[i] = 1;
+  // Elements that are not an old element with the same nodes (added, or renumbered onto a
+  // duplicate by the cut) touch their nodes, and so do the old elements they replace.
+  const int T0 = before.numTets();
+  if (static_cast<int>(change.element_old_to_new.size()) != T0)
+    return Error{"updateModelAfterCut3D: the change's element map does not match the mesh"};
+  std::vector<int> old_of(static_cast<size_t>(T1), -1);
+  for (int t = 0; t < T0; ++t) {
+    const int u = change.element_old_to_new[t];
+    if (u >= 0 && u < T1) old_of[u] = t;
+  }
+  auto touchOld = [&](int t) {
+    for (int k = 0; k < 4; ++k) {
+      const int j = o2n[before.T(t, k)];
+      if (j >= 0) touched[j] = 1;
+    }
+  };
+  for (int t = 0; t < T0; ++t)
+    if (change.element_old_to_new[t] < 0) touchOld(t);
+  for (int t = 0; t < T1; ++t) {
+    const int o = old_of[t];
+    bool same = o >= 0;
+    if (same) {
+      std::array<int, 4> a{}, b{};
+      for (int k = 0; k < 4; ++k) {
+        a[k] = after.T(t, k);
+        b[k] = o2n[before.T(o, k)];
+      }
+      std::sort(a.begin(), a.end());
+      std::sort(b.begin(), b.end());
+      same = a == b;
+    }
+    if (!same) {
+      touchTet(t);
+      if (o >= 0) touchOld(o);
+    }
+  }
+  for (int t : change.added_elements)
+    if (t >= 0 && t < T1) touchTet(t);
+  for (int i : change.moved_nodes)
+    if (i >= 0 && i < N1)
+      for (int e = off[i]; e < off[i + 1]; ++e) touchTet(around[e]);  // their volumes changed
+  std::vector<int> region_nodes;
+  for (int i = 0; i < N1; ++i)
+    if (touched[i]) region_nodes.push_back(i);
+  rep.touched_nodes = static_cast<int>(region_nodes.size());
+  for (int t : change.added_elements) {
+    if (t >= 0 && t < T1 && !(tetVolume(t) > 0.0))
+      return Error{"tet " + std::to_string(t) + " has non-positive volume " + std::to_string(tetVolume(t))};
+  }
+  // Mass region: the touched nodes and rings of neighbours (a cut's nodes lie near one
+  // surface, where the second moments across it are badly conditioned).
+  std::vector<std::uint8_t> region = touched;
+  for (int ring = 0, begin = 0; ring < options.mass_rings; ++ring) {
+    const int end = static_cast<int>(region_nodes.size());
+    for (int r = begin; r < end; ++r)
+      for (int e = off[region_nodes[r]]; e < off[region_nodes[r] + 1]; ++e)
+        for (int k = 0; k < 4; ++k) {
+          const int j = after.T(around[e], k);
+          if (!region[j]) {
+            region[j] = 1;
+            region_nodes.push_back(j);
+          }
+        }
+    begin = end;
+  }
+
+  // Masses: carried over outside the region; inside, lumped prior + smallest correction
+  // keeping the moments of the old masses they replace.
+  Eigen::VectorXd mass = Eigen::VectorXd::Zero(N1);
+  for (int i = 0; i < N0; ++i) {
+    const int j = o2n[i];
+    if (j >= 0 && !region[j]) mass[j] = model.mass[i];
+  }
+  std::vector<int> unknown;
+  for (int j : region_nodes) {
+    double lumped = 0.0;
+    for (int e = off[j]; e < off[j + 1]; ++e)
+      lumped += 0.25 * model.materials[material[around[e]]].density_g_mm3 * std::abs(tetVolume(around[e]));
+    mass[j] = lumped;
+    if (lumped > 0.0) unknown.push_back(j);
+  }
+  if (!unknown.empty()) {
+    Eigen::Vector3d lo = after.X.row(unknown[0]).transpose(), hi = lo;
+    for (int j : unknown) {
+      lo = lo.cwiseMin(after.X.row(j).transpose());
+      hi = hi.cwiseMax(after.X.row(j).transpose());
+    }
+    const Eigen::Vector3d centre = 0.5 * (lo + hi);
+    const double scale = std::max(0.5 * (hi - lo).maxCoeff(), 1e-12);
+    Row10 target = Row10::Zero();
+    for (int i = 0; i < N0; ++i) {
+      const int j = o2n[i];
+      if ((j < 0 || region[j]) && model.mass[i] != 0.0)
+        target += model.mass[i] * monomials((before.X.row(i).transpose() - centre) / scale);
+    }
+    auto moments = [&](const Eigen::VectorXd& m) {
+      Row10 p = Row10::Zero();
+      for (int j : region_nodes)
+        if (m[j] != 0.0) p += m[j] * monomials((after.X.row(j).transpose() - centre) / scale);
+      return p;
+    };
+    const Eigen::VectorXd prior = mass;
+    std::vector<std::uint8_t> clamped(static_cast<size_t>(N1), 0);
+    for (int iter = 0; iter < options.masses.max_active_set_iterations; ++iter) {
+      const Row10 r = target - moments(mass);
+      std::vector<int> active;
+      for (int i : unknown)
+        if (!clamped[i]) active.push_back(i);
+      if (active.empty()) break;
+      Eigen::Matrix<double, 10, Eigen::Dynamic> A(10, static_cast<Eigen::Index>(active.size()));
+      for (size_t j = 0; j < active.size(); ++j)
+        A.col(static_cast<Eigen::Index>(j)) = monomials((after.X.row(active[j]).transpose() - centre) / scale);
+      const Eigen::Matrix<double, 10, 10> B = A * A.transpose();
+      const Row10 y = Eigen::CompleteOrthogonalDecomposition<Eigen::Matrix<double, 10, 10>>(B).solve(r);
+      const Eigen::VectorXd dm = A.transpose() * y;
+      bool any = false;
+      for (size_t j = 0; j < active.size(); ++j) {
+        const int i = active[j];
+        const double floor = options.masses.floor_fraction * prior[i];
+        if (mass[i] + dm[static_cast<Eigen::Index>(j)] < floor) {
+          mass[i] = floor;
+          clamped[i] = 1;
+          any = true;
+        }
+      }
+      if (!any) {
+        for (size_t j = 0; j < active.size(); ++j) mass[active[j]] += dm[static_cast<Eigen::Index>(j)];
+        break;
+      }
+    }
+    const Row10 res = target - moments(mass);
+    rep.masses.unknowns = static_cast<int>(unknown.size());
+    for (int i : unknown) rep.masses.clamped += clamped[i];
+    rep.masses.moment_residual = res.cwiseAbs().maxCoeff() / std::max(target.cwiseAbs().maxCoeff(), 1e-300);
+  }
+  for (int j : region_nodes)
+    if (!(mass[j] >= 0.0) || !std::isfinite(mass[j])) return Error{"updateModelAfterCut3D: non-finite or negative mass"};
+
+  // Springs: unchanged unless both ends are touched; edges between touched nodes anew.
+  struct Spring {
+    int a, b;
+    double rest, k, c;
+  };
+  std::vector<Spring> springs;
+  springs.reserve(static_cast<size_t>(model.springs.rows()) + 64);
+  for (Eigen::Index s = 0; s < model.springs.rows(); ++s) {
+    const int a = o2n[model.springs(s, 0)], b = o2n[model.springs(s, 1)];
+    if (a < 0 || b < 0 || (touched[a] && touched[b])) continue;
+    springs.push_back({a, b, model.rest_length[s], model.stiffness[s], model.damping[s]});
+  }
+  std::vector<std::int64_t> keys;
+  for (int a : region_nodes) {
+    if (!touched[a]) continue;
+    for (int e = off[a]; e < off[a + 1]; ++e)
+      for (int k = 0; k < 4; ++k) {
+        const int b = after.T(around[e], k);
+        if (b > a && touched[b]) keys.push_back(static_cast<std::int64_t>(a) * N1 + b);
+      }
+  }
+  std::sort(keys.begin(), keys.end());
+  keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+  for (std::int64_t key : keys) {
+    const int a = static_cast<int>(key / N1), b = static_cast<int>(key % N1);
+    double ev = 0.0, bev = 0.0;
+    for (int e = off[a]; e < off[a + 1]; ++e) {
+      const int t = around[e];
+      if (after.T(t, 0) != b && after.T(t, 1) != b && after.T(t, 2) != b && after.T(t, 3) != b) continue;
+      const double vol = tetVolume(t);
+      if (!(vol > 0.0)) return Error{"tet " + std::to_string(t) + " has non-positive volume " + std::to_string(vol)};
+      const Material& mat = model.materials[material[t]];
+      ev += mat.young_modulus_pa * vol;
+      bev += mat.stiffness_damping_s * mat.young_modulus_pa * vol;
+    }
+    const double len = (after.X.row(b) - after.X.row(a)).norm();
+    springs.push_back({a, b, len, ev / (len * len), bev / (len * len)});
+  }
+  rep.springs_recomputed = static_cast<int>(keys.size());
+
+  // Pieces cut free leave; the rest is renumbered (order kept).
+  std::vector<std::int32_t> keep(node_to_kept);
+  if (keep.empty()) {
+    keep.resize(static_cast<size_t>(N1));
+    for (int i = 0; i < N1; ++i) keep[i] = i;
+  }
+  int N2 = 0;
+  for (int i = 0; i < N1; ++i) N2 = std::max(N2, keep[i] + 1);
+  Model& m = model;
+  const Eigen::MatrixX3d old_mode = m.stability_mode;
+  double overlap = old_mode.rows() == N0 ? 0.0 : 1.0;
+  if (old_mode.rows() == N0)
+    for (int i = 0; i < N0; ++i) {
+      const int j = o2n[i];
+      if (j < 0 || region[j] || keep[j] < 0) overlap += old_mode.row(i).squaredNorm();
+    }
+  m.num_nodes = N2;
+  m.mass = Eigen::VectorXd::Zero(N2);
+  m.fixed.assign(static_cast<size_t>(N2), 0);
+  std::vector<std::uint8_t> near(static_cast<size_t>(N2), 0);  // in the mass region
+  for (int i = 0; i < N1; ++i) {
+    const int j = keep[i];
+    if (j < 0) continue;
+    m.mass[j] = mass[i];
+    m.fixed[j] = fixed_after[i] || !(mass[i] > 0.0);  // unused nodes never move
+    near[j] = region[i];
+  }
+  m.inv_mass = Eigen::VectorXd::Zero(N2);
+  for (int i = 0; i < N2; ++i)
+    if (!m.fixed[i]) m.inv_mass[i] = 1.0 / m.mass[i];
+  int ns = 0;
+  for (const Spring& s : springs) ns += (keep[s.a] >= 0 && keep[s.b] >= 0) ? 1 : 0;
+  m.springs.resize(ns, 2);
+  m.rest_length.resize(ns);
+  m.stiffness.resize(ns);
+  m.damping.resize(ns);
+  for (int s = 0, out = 0; s < static_cast<int>(springs.size()); ++s) {
+    const Spring& sp = springs[s];
+    if (keep[sp.a] < 0 || keep[sp.b] < 0) continue;
+    m.springs(out, 0) = keep[sp.a];
+    m.springs(out, 1) = keep[sp.b];
+    m.rest_length[out] = sp.rest;
+    m.stiffness[out] = sp.k;
+    m.damping[out] = sp.c;
+    ++out;
+  }
+  buildStepSprings(m);
+  cutting::Positions X(N2, 3);
+  for (int i = 0; i < N1; ++i)
+    if (keep[i] >= 0) X.row(keep[i]) = after.X.row(i);
+  Eigen::MatrixX3d mapped_mode = Eigen::MatrixX3d::Zero(N2, 3);
+  if (old_mode.rows() == N0)
+    for (int i = 0; i < N0; ++i) {
+      const int j = o2n[i];
+      if (j >= 0 && keep[j] >= 0 && !m.fixed[keep[j]]) mapped_mode.row(keep[j]) = old_mode.row(i);
+    }
+
+  // Stability: near the cut, combined with the previous estimate when its mode lies
+  // elsewhere; over all free nodes otherwise.
+  const ModelOptions& opt = m.options;
+  double beta_max = 0.0;
+  for (const Material& mat : m.materials) beta_max = std::max(beta_max, mat.stiffness_damping_s);
+  auto stabilityLimit = [&](double omega) {
+    if (!(omega > 0.0)) return opt.dt;
+    const double zeta = 0.5 * beta_max * omega;
+    return 2.0 * (std::sqrt(1.0 + zeta * zeta) - zeta) / omega;
+  };
+  auto substepsFor = [&](double critical) {
+    return std::max(1, static_cast<int>(std::ceil(opt.dt / (opt.stability_safety * critical))));
+  };
+  rep.global_stability = overlap > options.mode_overlap || !(rep.omega_previous > 0.0);
+  std::vector<int> estimate_nodes;
+  for (int i = 0; i < N2; ++i)
+    if (!m.fixed[i] && (rep.global_stability || near[i])) estimate_nodes.push_back(i);
+  rep.stability_nodes = static_cast<int>(estimate_nodes.size());
+  auto estimate = [&]() {
+    Eigen::MatrixX3d ritz;
+    int steps = 0;
+    const double lambda =
+        topEigenvalue(m, X, estimate_nodes, rep.global_stability ? &mapped_mode : nullptr, options, &ritz, &steps);
+    rep.lanczos_steps += steps;
+    rep.omega_local = std::sqrt(lambda);
+    if (rep.global_stability || rep.omega_local >= rep.omega_previous) {
+      m.omega_max = rep.omega_local;
+      m.stability_mode = std::move(ritz);
+    } else {
+      m.omega_max = rep.omega_previous;
+      m.stability_mode = mapped_mode;
+    }
+    m.critical_dt = stabilityLimit(m.omega_max);
+  };
+  estimate();
+  // Selective mass scaling, as buildModel, on the nodes of the estimate.
+  if (opt.substeps <= 0 && opt.max_substeps > 0 && substepsFor(m.critical_dt) > opt.max_substeps) {
+    const StepSprings& st = m.step_springs;
+    double target = 0.8 * 2.0 * opt.stability_safety * opt.max_substeps / opt.dt;
+    for (int round = 0; round < 4 && substepsFor(m.critical_dt) > opt.max_substeps; ++round) {
+      for (int i : estimate_nodes) {
+        double k_sum = 0.0;
+        for (int e = st.node_offset[i]; e < st.node_offset[i + 1]; ++e) k_sum += st.stiffness[st.incident[e]];
+        const double needed = 2.0 * k_sum / (target * target);
+        if (m.mass[i] < needed) {
+          m.added_mass += needed - m.mass[i];
+          m.mass[i] = needed;
+          m.inv_mass[i] = 1.0 / needed;
+        }
+      }
+      estimate();
+      target *= 0.7;
+    }
+  }
+  m.substeps = opt.substeps > 0 ? opt.substeps : substepsFor(m.critical_dt);
+  if (opt.substeps <= 0 && opt.max_substeps > 0) m.substeps = std::min(m.substeps, opt.max_substeps);
+  m.substep = opt.dt / m.substeps;
+  m.implicit.reset();
+  if (opt.integrator == Integrator::ImplicitEuler) {
+    auto solver = ImplicitSolver::create(m);
+    if (!solver.ok()) return Error{solver.error()};
+    m.implicit = std::move(solver.value());
+  }
+  if (report) *report = rep;
+  return Status::Ok();
+}
+
+}  // namespace hysim::sim
