@@ -14,6 +14,7 @@
 // node in its worst element; each tried at decreasing lengths) are kept only if no incident
 // tet inverts and the worst incident q* rises: the local minimum quality never drops.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <vector>
 
@@ -65,8 +66,32 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   for (int t = 0; t < M; ++t) budget += tetVolume(mesh, t);
   budget *= options.volume_budget;
   auto pos = [&](int i) -> Vec3 { return mesh.X.row(i).transpose(); };
+  // q* of tet t, cached per tet with the node indices and positions it was computed from
+  // (a hit needs all of them unchanged, so the value is exactly what radiusRatio returns).
+  struct QEntry {
+    std::int32_t v[4];
+    double x[12];
+    double q;
+  };
+  std::vector<std::int32_t> qSlot(M, -1);
+  std::vector<QEntry> qPool;
   auto tetQ = [&](int t) {
-    return radiusRatio(pos(mesh.T(t, 0)), pos(mesh.T(t, 1)), pos(mesh.T(t, 2)), pos(mesh.T(t, 3)));
+    QEntry cur;
+    for (int k = 0; k < 4; ++k) {
+      cur.v[k] = mesh.T(t, k);
+      for (int a = 0; a < 3; ++a) cur.x[3 * k + a] = mesh.X(cur.v[k], a);
+    }
+    std::int32_t& slot = qSlot[t];
+    if (slot >= 0) {
+      const QEntry& e = qPool[slot];
+      if (std::equal(cur.v, cur.v + 4, e.v) && std::equal(cur.x, cur.x + 12, e.x)) return e.q;
+    } else {
+      slot = static_cast<std::int32_t>(qPool.size());
+      qPool.emplace_back();
+    }
+    cur.q = radiusRatio(pos(cur.v[0]), pos(cur.v[1]), pos(cur.v[2]), pos(cur.v[3]));
+    qPool[slot] = cur;
+    return cur.q;
   };
   // Quality of tet t with node n placed at y; negative when it would invert or go flat.
   auto tetQAt = [&](int t, int n, const Vec3& y) {
@@ -75,11 +100,14 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     if (!((p[1] - p[0]).dot((p[2] - p[0]).cross(p[3] - p[0])) > 0)) return -1.0;
     return radiusRatio(p[0], p[1], p[2], p[3]);
   };
-  auto starWorst = [&](int n, const Vec3& y, int* worstTet) {
+  // Worst q* around n where it is (tetQAt at its own position, through the cache).
+  auto starWorst = [&](int n, int* worstTet) {
     double q = 1.0;
     for (int s = off[n]; s < off[n + 1]; ++s) {
-      if ((*dead)[star[s]]) continue;
-      const double qt = tetQAt(star[s], n, y);
+      const int t = star[s];
+      if ((*dead)[t]) continue;
+      const Vec3 p0 = pos(mesh.T(t, 0)), p1 = pos(mesh.T(t, 1)), p2 = pos(mesh.T(t, 2)), p3 = pos(mesh.T(t, 3));
+      const double qt = (p1 - p0).dot((p2 - p0).cross(p3 - p0)) > 0 ? tetQ(t) : -1.0;
       if (qt < q) {
         q = qt;
         if (worstTet) *worstTet = star[s];
@@ -87,6 +115,21 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       }
     }
     return q;
+  };
+  // Is the worst q* around n with n at y above `floor`? Tet `first` (the likely worst) is
+  // tried first and the scan stops at the first tet at or below the floor; when it passes,
+  // *q receives the worst q* (as starWorst).
+  auto starAbove = [&](int n, const Vec3& y, int first, double floor, double* q) {
+    double worst = tetQAt(first, n, y);
+    if (!(worst > floor)) return false;
+    for (int s = off[n]; s < off[n + 1]; ++s) {
+      if (star[s] == first || (*dead)[star[s]]) continue;
+      const double qt = tetQAt(star[s], n, y);
+      if (!(qt > floor)) return false;
+      worst = std::min(worst, qt);
+    }
+    *q = std::min(1.0, worst);
+    return true;
   };
   // Where node n may move (see the file comment).
   struct BFace {
@@ -306,7 +349,8 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   auto collapseEdges = [&]() {
     if (!(options.collapse_fraction > 0)) return;
     std::vector<std::uint8_t> locked(N, 0);
-    std::vector<std::int32_t> dying, changing, vstar, keyA, keyB;
+    std::vector<std::int32_t> dying, changing, vstar;
+    std::vector<std::array<std::int32_t, 4>> keysB;
     struct Cand {
       double len;
       std::int32_t u, v;
@@ -375,16 +419,20 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
         if (c.shortEdge ? newMin < oldMin : !(newMin > oldMin)) continue;
         // No changed tet may coincide with a tet already around v.
         liveStar(v, vstar, nullptr);
-        for (int t : changing) {
-          keyA.assign({mesh.T(t, 0), mesh.T(t, 1), mesh.T(t, 2), mesh.T(t, 3)});
-          std::replace(keyA.begin(), keyA.end(), u, v);
-          std::sort(keyA.begin(), keyA.end());
-          for (int w : vstar) {
-            if (std::find(dying.begin(), dying.end(), w) != dying.end()) continue;
-            keyB.assign({mesh.T(w, 0), mesh.T(w, 1), mesh.T(w, 2), mesh.T(w, 3)});
-            std::sort(keyB.begin(), keyB.end());
-            if (keyA == keyB) ok = false;
-          }
+        keysB.clear();
+        for (int w : vstar) {
+          if (std::find(dying.begin(), dying.end(), w) != dying.end()) continue;
+          std::array<std::int32_t, 4> k{mesh.T(w, 0), mesh.T(w, 1), mesh.T(w, 2), mesh.T(w, 3)};
+          std::sort(k.begin(), k.end());
+          keysB.push_back(k);
+        }
+        for (size_t i = 0; i < changing.size() && ok; ++i) {
+          const int t = changing[i];
+          std::array<std::int32_t, 4> k{mesh.T(t, 0), mesh.T(t, 1), mesh.T(t, 2), mesh.T(t, 3)};
+          std::replace(k.begin(), k.end(), u, v);
+          std::sort(k.begin(), k.end());
+          for (const auto& kb : keysB)
+            if (k == kb) ok = false;
         }
         if (!ok) continue;
         // Apply, check manifoldness around v and the other nodes of the removed tets, or undo.
@@ -624,7 +672,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       if (c.kind == Freedom::Fixed) continue;
       const Vec3 x = pos(n);
       int wt = -1;
-      const double before = starWorst(n, x, &wt);
+      const double before = starWorst(n, &wt);
       if (before < 0 || before >= options.quality_target || wt < 0) continue;
       auto project = [&](Vec3 d) {
         if (c.kind == Freedom::Plane || c.kind == Freedom::Surface) d -= d.dot(c.normal) * c.normal;
@@ -687,8 +735,8 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
           Vec3 y = x + step * d;
           if (c.kind == Freedom::Surface) region.surface->signedDistance(Vec3(y), &y);
           if (!sideKept(n, x, y)) continue;
-          const double q = starWorst(n, y, nullptr);
-          if (q > best) {
+          double q = 0;
+          if (starAbove(n, y, wt, best, &q)) {
             best = q;
             bestX = y;
             break;
