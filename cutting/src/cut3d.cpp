@@ -288,35 +288,50 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
     std::int32_t u, v;
     Vec3 normal;
   };
+  // The topology does not change before the subdivision (step 3), where the last call is:
+  // the faces found for a node (three corners in the first tet's orientation, and the other
+  // two nodes) are kept, and the normals come from the current positions.
+  struct BFaceTopo {
+    std::int32_t i0, i1, i2, u, v;
+  };
+  std::vector<std::int32_t> bfStart(N0, -1), bfCount(N0, 0);
+  std::vector<BFaceTopo> bfPool;
+  struct Seen {
+    std::int32_t u, v, i0, i1, i2, count;
+  };
+  std::vector<Seen> seenFaces;
   auto boundaryFacesOf = [&](int n) {
-    std::vector<std::pair<FaceKey, Vec3>> faces;
-    std::vector<int> count;
-    for (int s = starOff[n]; s < starOff[n + 1]; ++s) {
-      const Tet tv = w.tet(starTet[s]);
-      const int ln = findLocal(tv, n);
-      for (int f = 0; f < 4; ++f) {
-        if (f == ln) continue;
-        const int i0 = tv[kFace[f][0]], i1 = tv[kFace[f][1]], i2 = tv[kFace[f][2]];
-        const FaceKey key = makeFace(i0, i1, i2);
-        bool found = false;
-        for (size_t q = 0; q < faces.size(); ++q)
-          if (faces[q].first == key) {
-            ++count[q];
-            found = true;
-          }
-        if (!found) {
-          faces.emplace_back(key, (w.x(i1) - w.x(i0)).cross(w.x(i2) - w.x(i0)));
-          count.push_back(1);
+    if (bfStart[n] < 0) {
+      seenFaces.clear();
+      for (int s = starOff[n]; s < starOff[n + 1]; ++s) {
+        const Tet tv = w.tet(starTet[s]);
+        const int ln = findLocal(tv, n);
+        for (int f = 0; f < 4; ++f) {
+          if (f == ln) continue;
+          const int i0 = tv[kFace[f][0]], i1 = tv[kFace[f][1]], i2 = tv[kFace[f][2]];
+          std::int32_t o[2], m = 0;
+          for (int v : {i0, i1, i2})
+            if (v != n) o[m++] = v;
+          if (o[0] > o[1]) std::swap(o[0], o[1]);
+          bool found = false;
+          for (auto& q : seenFaces)
+            if (q.u == o[0] && q.v == o[1]) {
+              ++q.count;
+              found = true;
+            }
+          if (!found) seenFaces.push_back({o[0], o[1], i0, i1, i2, 1});
         }
       }
+      bfStart[n] = static_cast<std::int32_t>(bfPool.size());
+      for (const auto& q : seenFaces)
+        if (q.count == 1) bfPool.push_back({q.i0, q.i1, q.i2, q.u, q.v});
+      bfCount[n] = static_cast<std::int32_t>(bfPool.size()) - bfStart[n];
     }
     std::vector<BFace> out;
-    for (size_t q = 0; q < faces.size(); ++q) {
-      if (count[q] != 1) continue;
-      std::int32_t o[2], m = 0;
-      for (int v : faces[q].first.v)
-        if (v != n) o[m++] = v;
-      out.push_back({o[0], o[1], faces[q].second.normalized()});
+    out.reserve(bfCount[n]);
+    for (int q = bfStart[n]; q < bfStart[n] + bfCount[n]; ++q) {
+      const BFaceTopo& f = bfPool[q];
+      out.push_back({f.u, f.v, Vec3((w.x(f.i1) - w.x(f.i0)).cross(w.x(f.i2) - w.x(f.i0))).normalized()});
     }
     return out;
   };
