@@ -215,6 +215,11 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   // the mesh stays manifold: the boundary faces around each of its nodes still form one
   // closed loop (a disc), or the node had no other tet (it goes with the sliver). Its volume (tiny: it is flat) is lost.
   std::vector<std::int32_t> link;  // scratch: link edges of a node, as pairs
+  std::vector<std::uint64_t> pairKeys;  // scratch: node pairs of the tets around a node
+  auto pairKey = [](std::int32_t a, std::int32_t b) {
+    if (a > b) std::swap(a, b);
+    return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(a)) << 32) | static_cast<std::uint32_t>(b);
+  };
   auto boundaryFaceCount = [&](int t) {
     int count = 0;
     for (int f = 0; f < 4; ++f) {
@@ -246,6 +251,17 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   auto discAround = [&](int v, const std::vector<std::int32_t>& around) {
     link.clear();
     if (around.empty()) return true;
+    // Every tet of `around` has v; a face (v, a, b) is used by the tets with both a and b:
+    // the pairs of each tet's other three nodes, sorted, counted by binary search.
+    pairKeys.clear();
+    for (int t : around) {
+      std::int32_t o[3], m = 0;
+      for (int k = 0; k < 4; ++k)
+        if (mesh.T(t, k) != v && m < 3) o[m++] = mesh.T(t, k);
+      for (int i = 0; i < m; ++i)
+        for (int j = i + 1; j < m; ++j) pairKeys.push_back(pairKey(o[i], o[j]));
+    }
+    std::sort(pairKeys.begin(), pairKeys.end());
     for (int t : around) {
       int lv = 0;
       while (mesh.T(t, lv) != v) ++lv;
@@ -254,12 +270,8 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
         std::int32_t o[2], m = 0;
         for (int k = 0; k < 3; ++k)
           if (mesh.T(t, kFace[f][k]) != v) o[m++] = mesh.T(t, kFace[f][k]);
-        int uses = 0;
-        for (int u : around) {
-          int hits = 0;
-          for (int k = 0; k < 4; ++k) hits += mesh.T(u, k) == o[0] || mesh.T(u, k) == o[1];
-          uses += hits == 2;
-        }
+        const auto range = std::equal_range(pairKeys.begin(), pairKeys.end(), pairKey(o[0], o[1]));
+        const int uses = static_cast<int>(range.second - range.first);
         if (uses > 2) return false;
         if (uses == 1) {
           link.push_back(o[0]);
@@ -304,7 +316,14 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
         tetMark[t] = markRound;
         out.push_back(t);
       }
-    std::sort(out.begin(), out.end());
+    // Index order: a scan of the marks is cheaper than sorting thousands of tets.
+    if (out.size() * 8 > static_cast<size_t>(M)) {
+      out.clear();
+      for (int t = 0; t < M; ++t)
+        if (tetMark[t] == markRound) out.push_back(t);
+    } else {
+      std::sort(out.begin(), out.end());
+    }
   };
   auto peel = [&]() {
     if (!(options.peel_quality > 0)) return;
