@@ -404,24 +404,25 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
         if (locked[u] || locked[v]) continue;
         dying.clear();
         changing.clear();
-        double oldMin = 1.0, newMin = 1.0;
         for (int s = off[u]; s < off[u + 1]; ++s) {
           const int t = star[s];
           if ((*dead)[t]) continue;
           bool hasV = false;
           for (int k = 0; k < 4; ++k) hasV = hasV || mesh.T(t, k) == v;
           (hasV ? dying : changing).push_back(t);
-          oldMin = std::min(oldMin, tetQ(t));
         }
         if (dying.empty()) continue;  // not an edge any more
+        // Checks in order of cost (all must pass): no changed tet inverts or goes flat, the
+        // volume changes within the limits, the worst q* rises (short edges: does not fall).
         bool ok = true;
+        const Vec3 xv = pos(v);
         for (int t : changing) {
-          const double q = tetQAt(t, u, pos(v));
-          if (q < 0) {
+          Vec3 p[4];
+          for (int k = 0; k < 4; ++k) p[k] = mesh.T(t, k) == u ? xv : pos(mesh.T(t, k));
+          if (!((p[1] - p[0]).dot((p[2] - p[0]).cross(p[3] - p[0])) > 0)) {
             ok = false;
             break;
           }
-          newMin = std::min(newMin, q);
         }
         if (!ok) continue;
         // Volume: the removed tets and the change of the others, against u's star.
@@ -435,7 +436,19 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
         }
         const double change = std::abs(after - before);
         if (change > options.collapse_volume_fraction * before || change > budget) continue;
-        if (c.shortEdge ? newMin < oldMin : !(newMin > oldMin)) continue;
+        double oldMin = 1.0;
+        for (int t : dying) oldMin = std::min(oldMin, tetQ(t));
+        for (int t : changing) oldMin = std::min(oldMin, tetQ(t));
+        // newMin = the worst q* after; stop as soon as it fails against oldMin.
+        double newMin = 1.0;
+        for (int t : changing) {
+          newMin = std::min(newMin, tetQAt(t, u, xv));
+          if (c.shortEdge ? newMin < oldMin : !(newMin > oldMin)) {
+            ok = false;
+            break;
+          }
+        }
+        if (!ok || (c.shortEdge ? newMin < oldMin : !(newMin > oldMin))) continue;
         // No changed tet may coincide with a tet already around v.
         liveStar(v, vstar, nullptr);
         keysB.clear();
