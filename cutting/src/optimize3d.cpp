@@ -63,7 +63,12 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   // Peeling and collapses change the volume; together they may change it by at most
   // volume_budget of the mesh's volume.
   double budget = 0;
-  for (int t = 0; t < M; ++t) budget += tetVolume(mesh, t);
+  for (int t = 0; t < M; ++t) {
+    // tetVolume, inline.
+    const Vec3 x0 = mesh.X.row(mesh.T(t, 0)), x1 = mesh.X.row(mesh.T(t, 1)), x2 = mesh.X.row(mesh.T(t, 2)),
+               x3 = mesh.X.row(mesh.T(t, 3));
+    budget += (x1 - x0).dot((x2 - x0).cross(x3 - x0)) / 6.0;
+  }
   budget *= options.volume_budget;
   auto pos = [&](int i) -> Vec3 { return mesh.X.row(i).transpose(); };
   // q* of tet t, cached per tet with the node indices and positions it was computed from
@@ -368,7 +373,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   auto collapseEdges = [&]() {
     if (!(options.collapse_fraction > 0)) return;
     std::vector<std::uint8_t> locked(N, 0);
-    std::vector<std::int32_t> dying, changing, vstar;
+    std::vector<std::int32_t> dying, changing, vstar, checked;
     std::vector<std::array<std::int32_t, 4>> keysB;
     struct Cand {
       double len;
@@ -474,10 +479,13 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
             if (mesh.T(t, k) == u) mesh.T(t, k) = v;
         liveStar(v, around, &changing);
         ok = discAround(v, around);
+        // (Each node once: the nodes around the edge are in two of the removed tets.)
+        checked.clear();
         for (size_t i = 0; i < dying.size() && ok; ++i)
           for (int k = 0; k < 4 && ok; ++k) {
             const int w = mesh.T(dying[i], k);
-            if (w == u || w == v) continue;
+            if (w == u || w == v || std::find(checked.begin(), checked.end(), w) != checked.end()) continue;
+            checked.push_back(w);
             liveStar(w, around, nullptr);
             ok = discAround(w, around);
           }
