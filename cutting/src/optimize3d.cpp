@@ -45,19 +45,65 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   std::vector<std::uint8_t> onCut = region.on_cut;  // grows: nodes snapped onto the cut here
   const double cosFlat = std::cos(options.boundary_flat_deg * M_PI / 180.0);
 
-  // Node -> tets of the whole mesh (one O(#T) pass; everything else is local).
-  // Rebuilt after edge collapses (live tets only).
+  // Node -> tets of the whole mesh (one O(#T) pass; everything else is local), live tets in
+  // index order. After edge collapses the lists of the nodes whose tets died or changed are
+  // rebuilt (buildStars), into `ovrPool`; the others keep their CSR rows.
   std::vector<std::int32_t> off(N + 1, 0), star(4 * static_cast<size_t>(M));
+  std::vector<std::int32_t> ovrStart(N, -1), ovrLen(N, 0), ovrPool;
+  std::vector<std::uint8_t> touched(N, 0);
+  std::vector<std::int32_t> touchedList;
+  std::vector<std::pair<std::int32_t, std::int32_t>> gained;  // (node, tet): tet took the node
+  auto starB = [&](int n) -> const std::int32_t* {
+    return ovrStart[n] >= 0 ? ovrPool.data() + ovrStart[n] : star.data() + off[n];
+  };
+  auto starE = [&](int n) -> const std::int32_t* {
+    return ovrStart[n] >= 0 ? ovrPool.data() + ovrStart[n] + ovrLen[n] : star.data() + off[n + 1];
+  };
+  auto touch = [&](int n) {
+    if (!touched[n]) {
+      touched[n] = 1;
+      touchedList.push_back(n);
+    }
+  };
+  auto kill = [&](int t) {
+    (*dead)[t] = 1;
+    for (int k = 0; k < 4; ++k) touch(mesh.T(t, k));
+  };
+  bool built = false;
+  std::vector<std::int32_t> scratch;
   auto buildStars = [&]() {
-    std::fill(off.begin(), off.end(), 0);
-    for (int t = 0; t < M; ++t)
-      if (!(*dead)[t])
-        for (int k = 0; k < 4; ++k) ++off[mesh.T(t, k) + 1];
-    for (int i = 0; i < N; ++i) off[i + 1] += off[i];
-    std::vector<std::int32_t> fill(off.begin(), off.end() - 1);
-    for (int t = 0; t < M; ++t)
-      if (!(*dead)[t])
-        for (int k = 0; k < 4; ++k) star[fill[mesh.T(t, k)]++] = t;
+    if (!built) {
+      built = true;
+      for (int t = 0; t < M; ++t)
+        if (!(*dead)[t])
+          for (int k = 0; k < 4; ++k) ++off[mesh.T(t, k) + 1];
+      for (int i = 0; i < N; ++i) off[i + 1] += off[i];
+      std::vector<std::int32_t> fill(off.begin(), off.end() - 1);
+      for (int t = 0; t < M; ++t)
+        if (!(*dead)[t])
+          for (int k = 0; k < 4; ++k) star[fill[mesh.T(t, k)]++] = t;
+      return;
+    }
+    // The same lists as a full rebuild: live tets with the node, in index order.
+    std::sort(gained.begin(), gained.end());
+    for (int n : touchedList) {
+      scratch.assign(starB(n), starE(n));
+      auto g = std::lower_bound(gained.begin(), gained.end(), std::make_pair(static_cast<std::int32_t>(n), std::int32_t{-1}));
+      for (; g != gained.end() && g->first == n; ++g) scratch.push_back(g->second);
+      std::sort(scratch.begin(), scratch.end());
+      scratch.erase(std::unique(scratch.begin(), scratch.end()), scratch.end());
+      ovrStart[n] = static_cast<std::int32_t>(ovrPool.size());
+      for (int t : scratch) {
+        if ((*dead)[t]) continue;
+        bool has = false;
+        for (int k = 0; k < 4; ++k) has = has || mesh.T(t, k) == n;
+        if (has) ovrPool.push_back(t);
+      }
+      ovrLen[n] = static_cast<std::int32_t>(ovrPool.size()) - ovrStart[n];
+      touched[n] = 0;
+    }
+    touchedList.clear();
+    gained.clear();
   };
   buildStars();
   // Peeling and collapses change the volume; together they may change it by at most
@@ -108,14 +154,14 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   // Worst q* around n where it is (tetQAt at its own position, through the cache).
   auto starWorst = [&](int n, int* worstTet) {
     double q = 1.0;
-    for (int s = off[n]; s < off[n + 1]; ++s) {
-      const int t = star[s];
+    for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s) {
+      const int t = (*s);
       if ((*dead)[t]) continue;
       const Vec3 p0 = pos(mesh.T(t, 0)), p1 = pos(mesh.T(t, 1)), p2 = pos(mesh.T(t, 2)), p3 = pos(mesh.T(t, 3));
       const double qt = (p1 - p0).dot((p2 - p0).cross(p3 - p0)) > 0 ? tetQ(t) : -1.0;
       if (qt < q) {
         q = qt;
-        if (worstTet) *worstTet = star[s];
+        if (worstTet) *worstTet = (*s);
         if (qt < 0) return qt;
       }
     }
@@ -127,9 +173,9 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   auto starAbove = [&](int n, const Vec3& y, int first, double floor, double* q) {
     double worst = tetQAt(first, n, y);
     if (!(worst > floor)) return false;
-    for (int s = off[n]; s < off[n + 1]; ++s) {
-      if (star[s] == first || (*dead)[star[s]]) continue;
-      const double qt = tetQAt(star[s], n, y);
+    for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s) {
+      if ((*s) == first || (*dead)[(*s)]) continue;
+      const double qt = tetQAt((*s), n, y);
       if (!(qt > floor)) return false;
       worst = std::min(worst, qt);
     }
@@ -146,8 +192,8 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   auto constraintOf = [&](int n) {
     Constraint c;
     faces.clear();
-    for (int s = off[n]; s < off[n + 1]; ++s) {
-      const int t = star[s];
+    for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s) {
+      const int t = (*s);
       if ((*dead)[t]) continue;
       int ln = 0;
       while (mesh.T(t, ln) != n) ++ln;
@@ -230,8 +276,8 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     for (int f = 0; f < 4; ++f) {
       const int a = mesh.T(t, kFace[f][0]), b = mesh.T(t, kFace[f][1]), c = mesh.T(t, kFace[f][2]);
       bool shared = false;
-      for (int s = off[a]; s < off[a + 1] && !shared; ++s) {
-        const int u = star[s];
+      for (const std::int32_t *s = starB(a), *sEnd = starE(a); s < sEnd && !shared; ++s) {
+        const int u = (*s);
         if (u == t || (*dead)[u]) continue;
         int hits = 0;
         for (int k = 0; k < 4; ++k) hits += mesh.T(u, k) == b || mesh.T(u, k) == c;
@@ -244,8 +290,8 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   // The tets around v (live ones from the node->tet lists, plus `extra`).
   auto liveStar = [&](int v, std::vector<std::int32_t>& out, const std::vector<std::int32_t>* extra) {
     out.clear();
-    for (int s = off[v]; s < off[v + 1]; ++s)
-      if (!(*dead)[star[s]]) out.push_back(star[s]);
+    for (const std::int32_t *s = starB(v), *sEnd = starE(v); s < sEnd; ++s)
+      if (!(*dead)[(*s)]) out.push_back((*s));
     if (extra)
       for (int t : *extra)
         if (!(*dead)[t]) out.push_back(t);
@@ -315,8 +361,8 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     ++markRound;
     out.clear();
     for (int n : region.seeds)
-      for (int s = off[n]; s < off[n + 1]; ++s) {
-        const int t = star[s];
+      for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s) {
+        const int t = (*s);
         if ((*dead)[t] || tetMark[t] == markRound) continue;
         tetMark[t] = markRound;
         out.push_back(t);
@@ -341,7 +387,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       again = false;
       for (int t : candidates) {
         if ((*dead)[t] || boundaryFaceCount(t) == 0 || tetVolume(mesh, t) > budget) continue;
-        (*dead)[t] = 1;
+        kill(t);
         bool ok = true;
         for (int k = 0; k < 4 && ok; ++k) {
           liveStar(mesh.T(t, k), around, nullptr);
@@ -409,8 +455,8 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
         if (locked[u] || locked[v]) continue;
         dying.clear();
         changing.clear();
-        for (int s = off[u]; s < off[u + 1]; ++s) {
-          const int t = star[s];
+        for (const std::int32_t *s = starB(u), *sEnd = starE(u); s < sEnd; ++s) {
+          const int t = (*s);
           if ((*dead)[t]) continue;
           bool hasV = false;
           for (int k = 0; k < 4; ++k) hasV = hasV || mesh.T(t, k) == v;
@@ -473,10 +519,14 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
         }
         if (!ok) continue;
         // Apply, check manifoldness around v and the other nodes of the removed tets, or undo.
-        for (int t : dying) (*dead)[t] = 1;
-        for (int t : changing)
+        for (int t : dying) kill(t);
+        touch(u);
+        touch(v);
+        for (int t : changing) {
+          gained.emplace_back(v, t);
           for (int k = 0; k < 4; ++k)
             if (mesh.T(t, k) == u) mesh.T(t, k) = v;
+        }
         liveStar(v, around, &changing);
         ok = discAround(v, around);
         // (Each node once: the nodes around the edge are in two of the removed tets.)
@@ -539,8 +589,8 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     auto trySnap = [&](int* partner) {
       tets.clear();
       for (int g : group)
-        for (int s = off[g]; s < off[g + 1]; ++s)
-          if (!(*dead)[star[s]]) tets.push_back(star[s]);
+        for (const std::int32_t *s = starB(g), *sEnd = starE(g); s < sEnd; ++s)
+          if (!(*dead)[(*s)]) tets.push_back((*s));
       std::sort(tets.begin(), tets.end());
       tets.erase(std::unique(tets.begin(), tets.end()), tets.end());
       dying.clear();
@@ -587,7 +637,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
         groupFrom.push_back(pos(group[g]));
         mesh.X.row(group[g]) = groupTo[g].transpose();
       }
-      for (int t : dying) (*dead)[t] = 1;
+      for (int t : dying) kill(t);
       bool ok = true;
       for (size_t g = 0; g < group.size() && ok; ++g) {
         liveStar(group[g], around, nullptr);
@@ -621,8 +671,8 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       targets.clear();
       targets.emplace_back();
       region.surface->signedDistance(pos(u), &targets.back());
-      for (int s = off[u]; s < off[u + 1]; ++s) {
-        const int t = star[s];
+      for (const std::int32_t *s = starB(u), *sEnd = starE(u); s < sEnd; ++s) {
+        const int t = (*s);
         if ((*dead)[t]) continue;
         for (int i = 0; i < 4; ++i)
           for (int j = i + 1; j < 4; ++j) {
@@ -673,9 +723,9 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     for (int r = 1; r <= options.rings && !frontier.empty(); ++r) {
       next.clear();
       for (int n : frontier)
-        for (int s = off[n]; s < off[n + 1]; ++s)
+        for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s)
           for (int k = 0; k < 4; ++k) {
-            const int v = mesh.T(star[s], k);
+            const int v = mesh.T((*s), k);
             if (ring[v] < 0) {
               ring[v] = static_cast<std::int8_t>(r);
               next.push_back(v);
@@ -687,8 +737,8 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   // Work list: the nodes of poor elements around the seeds.
   std::vector<std::int32_t> stamp(N, -1), work;
   auto addBadAround = [&](int n, int round) {
-    for (int s = off[n]; s < off[n + 1]; ++s) {
-      const int t = star[s];
+    for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s) {
+      const int t = (*s);
       if ((*dead)[t] || tetQ(t) >= options.quality_target) continue;
       for (int k = 0; k < 4; ++k) {
         const int v = mesh.T(t, k);
@@ -728,9 +778,9 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       double sum = 0;
       int deg = 0;
       Vec3 force = Vec3::Zero();
-      for (int s = off[n]; s < off[n + 1]; ++s)
-        for (int k = 0; k < 4 && !(*dead)[star[s]]; ++k) {
-          const int m = mesh.T(star[s], k);
+      for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s)
+        for (int k = 0; k < 4 && !(*dead)[(*s)]; ++k) {
+          const int m = mesh.T((*s), k);
           if (m == n) continue;
           sum += (pos(m) - x).norm();
           ++deg;
@@ -738,9 +788,9 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       if (deg == 0) continue;
       const double h = sum / deg;
       scale = std::max(scale, h);
-      for (int s = off[n]; s < off[n + 1]; ++s)
-        for (int k = 0; k < 4 && !(*dead)[star[s]]; ++k) {
-          const int m = mesh.T(star[s], k);
+      for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s)
+        for (int k = 0; k < 4 && !(*dead)[(*s)]; ++k) {
+          const int m = mesh.T((*s), k);
           if (m == n) continue;
           const Vec3 d = pos(m) - x;
           const double len = d.norm();
