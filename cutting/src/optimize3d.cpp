@@ -15,6 +15,7 @@
 // tet inverts and the worst incident q* rises: the local minimum quality never drops.
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
 #include <vector>
 
@@ -355,25 +356,28 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   std::vector<std::int32_t> around;
   std::vector<std::int32_t> lateSnapped;  // nodes snapNear moved onto the cut
   // The live tets around the seeds, each once, in index order.
-  std::vector<std::int32_t> tetMark(M, -1);
-  int markRound = 0;
+  // A bit per tet: set while collecting, read back word by word (index order), cleared.
+  std::vector<std::uint64_t> tetBits(static_cast<size_t>(M) / 64 + 1, 0);
+  std::vector<std::int32_t> bitWords;
   auto regionTets = [&](std::vector<std::int32_t>& out) {
-    ++markRound;
     out.clear();
+    bitWords.clear();
     for (int n : region.seeds)
       for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s) {
         const int t = (*s);
-        if ((*dead)[t] || tetMark[t] == markRound) continue;
-        tetMark[t] = markRound;
-        out.push_back(t);
+        if ((*dead)[t]) continue;
+        std::uint64_t& word = tetBits[static_cast<size_t>(t) >> 6];
+        if (word == 0) bitWords.push_back(t >> 6);
+        word |= std::uint64_t{1} << (t & 63);
       }
-    // Index order: a scan of the marks is cheaper than sorting thousands of tets.
-    if (out.size() * 8 > static_cast<size_t>(M)) {
-      out.clear();
-      for (int t = 0; t < M; ++t)
-        if (tetMark[t] == markRound) out.push_back(t);
-    } else {
-      std::sort(out.begin(), out.end());
+    std::sort(bitWords.begin(), bitWords.end());
+    for (int wi : bitWords) {
+      std::uint64_t word = tetBits[wi];
+      tetBits[wi] = 0;
+      while (word) {
+        out.push_back(wi * 64 + std::countr_zero(word));
+        word &= word - 1;
+      }
     }
   };
   auto peel = [&]() {
