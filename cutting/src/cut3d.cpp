@@ -42,9 +42,11 @@ struct FaceKeyHash {
   }
 };
 FaceKey makeFace(std::int32_t a, std::int32_t b, std::int32_t c) {
-  FaceKey k{{a, b, c}};
-  std::sort(k.v.begin(), k.v.end());
-  return k;
+  // Sorted (three compare-exchanges).
+  if (a > b) std::swap(a, b);
+  if (b > c) std::swap(b, c);
+  if (a > b) std::swap(a, b);
+  return FaceKey{{a, b, c}};
 }
 
 // Outward faces of a positive tet, by the local index of the opposite vertex.
