@@ -267,11 +267,8 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   // the mesh stays manifold: the boundary faces around each of its nodes still form one
   // closed loop (a disc), or the node had no other tet (it goes with the sliver). Its volume (tiny: it is flat) is lost.
   std::vector<std::int32_t> link;  // scratch: link edges of a node, as pairs
-  std::vector<std::uint64_t> pairKeys;  // scratch: node pairs of the tets around a node
-  auto pairKey = [](std::int32_t a, std::int32_t b) {
-    if (a > b) std::swap(a, b);
-    return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(a)) << 32) | static_cast<std::uint32_t>(b);
-  };
+  // Scratch for discAround: v's neighbours, their local numbers (-1 elsewhere), pair counts.
+  std::vector<std::int32_t> nbrs, localId(N, -1), pairCount;
   auto boundaryFaceCount = [&](int t) {
     int count = 0;
     for (int f = 0; f < 4; ++f) {
@@ -304,17 +301,28 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     link.clear();
     if (around.empty()) return true;
     // Every tet of `around` has v; a face (v, a, b) is used by the tets with both a and b:
-    // the pairs of each tet's other three nodes, sorted, counted by binary search.
-    pairKeys.clear();
+    // count the pairs of each tet's other three nodes in a table over v's neighbours.
+    nbrs.clear();
+    for (int t : around)
+      for (int k = 0; k < 4; ++k) {
+        const int w = mesh.T(t, k);
+        if (w != v && localId[w] < 0) {
+          localId[w] = static_cast<std::int32_t>(nbrs.size());
+          nbrs.push_back(w);
+        }
+      }
+    const size_t L = nbrs.size();
+    pairCount.assign(L * L, 0);
     for (int t : around) {
       std::int32_t o[3], m = 0;
       for (int k = 0; k < 4; ++k)
-        if (mesh.T(t, k) != v && m < 3) o[m++] = mesh.T(t, k);
+        if (mesh.T(t, k) != v && m < 3) o[m++] = localId[mesh.T(t, k)];
       for (int i = 0; i < m; ++i)
-        for (int j = i + 1; j < m; ++j) pairKeys.push_back(pairKey(o[i], o[j]));
+        for (int j = i + 1; j < m; ++j) ++pairCount[std::min(o[i], o[j]) * L + std::max(o[i], o[j])];
     }
-    std::sort(pairKeys.begin(), pairKeys.end());
-    for (int t : around) {
+    bool manifold = true;
+    for (size_t i = 0; i < around.size() && manifold; ++i) {
+      const int t = around[i];
       int lv = 0;
       while (mesh.T(t, lv) != v) ++lv;
       for (int f = 0; f < 4; ++f) {
@@ -322,15 +330,20 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
         std::int32_t o[2], m = 0;
         for (int k = 0; k < 3; ++k)
           if (mesh.T(t, kFace[f][k]) != v) o[m++] = mesh.T(t, kFace[f][k]);
-        const auto range = std::equal_range(pairKeys.begin(), pairKeys.end(), pairKey(o[0], o[1]));
-        const int uses = static_cast<int>(range.second - range.first);
-        if (uses > 2) return false;
+        const std::int32_t a = localId[o[0]], b = localId[o[1]];
+        const int uses = pairCount[std::min(a, b) * L + std::max(a, b)];
+        if (uses > 2) {
+          manifold = false;
+          break;
+        }
         if (uses == 1) {
           link.push_back(o[0]);
           link.push_back(o[1]);
         }
       }
     }
+    for (int w : nbrs) localId[w] = -1;
+    if (!manifold) return false;
     if (link.empty()) return true;  // interior node
     // One closed loop: every link vertex has degree 2, and walking from one edge visits all.
     const size_t edges = link.size() / 2;
