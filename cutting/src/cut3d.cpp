@@ -302,9 +302,20 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
     std::int32_t u, v, i0, i1, i2, count;
   };
   std::vector<Seen> seenFaces;
+  std::vector<std::int32_t> bfNbrs, bfLocal(N0, -1), faceAt;
   auto boundaryFacesOf = [&](int n) {
     if (bfStart[n] < 0) {
       seenFaces.clear();
+      // Local numbers of n's neighbours; faceAt: (pair of them) -> index in seenFaces.
+      bfNbrs.clear();
+      for (int s = starOff[n]; s < starOff[n + 1]; ++s)
+        for (const int v : w.tet(starTet[s]))
+          if (v != n && bfLocal[v] < 0) {
+            bfLocal[v] = static_cast<std::int32_t>(bfNbrs.size());
+            bfNbrs.push_back(v);
+          }
+      const size_t L = bfNbrs.size();
+      faceAt.assign(L * L, -1);
       for (int s = starOff[n]; s < starOff[n + 1]; ++s) {
         const Tet tv = w.tet(starTet[s]);
         const int ln = findLocal(tv, n);
@@ -315,15 +326,17 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
           for (int v : {i0, i1, i2})
             if (v != n) o[m++] = v;
           if (o[0] > o[1]) std::swap(o[0], o[1]);
-          bool found = false;
-          for (auto& q : seenFaces)
-            if (q.u == o[0] && q.v == o[1]) {
-              ++q.count;
-              found = true;
-            }
-          if (!found) seenFaces.push_back({o[0], o[1], i0, i1, i2, 1});
+          const std::int32_t a = bfLocal[o[0]], b = bfLocal[o[1]];
+          std::int32_t& at = faceAt[std::min(a, b) * L + std::max(a, b)];
+          if (at >= 0) {
+            ++seenFaces[at].count;
+          } else {
+            at = static_cast<std::int32_t>(seenFaces.size());
+            seenFaces.push_back({o[0], o[1], i0, i1, i2, 1});
+          }
         }
       }
+      for (int v : bfNbrs) bfLocal[v] = -1;
       bfStart[n] = static_cast<std::int32_t>(bfPool.size());
       for (const auto& q : seenFaces)
         if (q.count == 1) bfPool.push_back({q.i0, q.i1, q.i2, q.u, q.v});
