@@ -820,7 +820,7 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
     }
     const size_t numCut = cutNodes.size();
     std::vector<int> parent;
-    std::vector<std::pair<FaceKey, int>> faceOwner;
+    std::vector<std::int32_t> sepLocal, sepNbrs, firstTet;
     for (size_t i = 0; i < numCut; ++i) {
       const int n = cutNodes[i];
       auto& st = star[i];
@@ -831,20 +831,36 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
         while (parent[x] != x) x = parent[x] = parent[parent[x]];
         return x;
       };
-      faceOwner.clear();
+      // Tets sharing a face with n that is not cut are in one group: faces by the pair of
+      // their other two nodes (local numbers over n's neighbours), the first tet seen for each.
+      if (sepLocal.size() < static_cast<size_t>(w.numNodes())) sepLocal.resize(w.numNodes(), -1);
+      sepNbrs.clear();
+      for (int t : st)
+        for (const int v : w.tet(t))
+          if (v != n && sepLocal[v] < 0) {
+            sepLocal[v] = static_cast<std::int32_t>(sepNbrs.size());
+            sepNbrs.push_back(v);
+          }
+      const size_t L = sepNbrs.size();
+      firstTet.assign(L * L, -1);
       for (size_t j = 0; j < st.size(); ++j) {
         const Tet tv = w.tet(st[j]);
         const int ln = findLocal(tv, n);
         for (int f = 0; f < 4; ++f) {
           if (f == ln) continue;
-          faceOwner.emplace_back(makeFace(tv[kFace[f][0]], tv[kFace[f][1]], tv[kFace[f][2]]), static_cast<int>(j));
+          std::int32_t o[2], m = 0;
+          for (int k = 0; k < 3; ++k)
+            if (tv[kFace[f][k]] != n) o[m++] = tv[kFace[f][k]];
+          const std::int32_t a = sepLocal[o[0]], b = sepLocal[o[1]];
+          std::int32_t& first = firstTet[std::min(a, b) * L + std::max(a, b)];
+          if (first < 0) {
+            first = static_cast<std::int32_t>(j);
+          } else if (!cutFaces.count(makeFace(n, o[0], o[1]))) {
+            parent[find(first)] = find(static_cast<int>(j));
+          }
         }
       }
-      std::sort(faceOwner.begin(), faceOwner.end(),
-                [](const std::pair<FaceKey, int>& x, const std::pair<FaceKey, int>& y) { return x.first < y.first; });
-      for (size_t q = 0; q + 1 < faceOwner.size(); ++q)
-        if (faceOwner[q].first == faceOwner[q + 1].first && !cutFaces.count(faceOwner[q].first))
-          parent[find(faceOwner[q].second)] = find(faceOwner[q + 1].second);
+      for (int v : sepNbrs) sepLocal[v] = -1;
       // The group of the first tet keeps n; every other group gets a copy.
       std::vector<int> copyOf(st.size(), -1);
       const int keep = find(0);
