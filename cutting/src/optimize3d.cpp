@@ -183,6 +183,9 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     *q = std::min(1.0, worst);
     return true;
   };
+  // Scratch for constraintOf and discAround: a node's neighbours, their local numbers (-1
+  // elsewhere), a table over pairs of them.
+  std::vector<std::int32_t> nbrs, localId(N, -1), pairCount;
   // Where node n may move (see the file comment).
   struct BFace {
     std::int32_t u, v;
@@ -193,6 +196,19 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   auto constraintOf = [&](int n) {
     Constraint c;
     faces.clear();
+    // Faces by the pair of their nodes other than n (local numbers over n's neighbours).
+    nbrs.clear();
+    for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s)
+      if (!(*dead)[*s])
+        for (int k = 0; k < 4; ++k) {
+          const int w = mesh.T(*s, k);
+          if (w != n && localId[w] < 0) {
+            localId[w] = static_cast<std::int32_t>(nbrs.size());
+            nbrs.push_back(w);
+          }
+        }
+    const size_t L = nbrs.size();
+    pairCount.assign(L * L, -1);  // index into faces
     for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s) {
       const int t = (*s);
       if ((*dead)[t]) continue;
@@ -205,15 +221,17 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
         for (int v : {i0, i1, i2})
           if (v != n) o[m++] = v;
         if (o[0] > o[1]) std::swap(o[0], o[1]);
-        bool found = false;
-        for (auto& bf : faces)
-          if (bf.u == o[0] && bf.v == o[1]) {
-            ++bf.count;
-            found = true;
-          }
-        if (!found) faces.push_back({o[0], o[1], (pos(i1) - pos(i0)).cross(pos(i2) - pos(i0)), 1});
+        const std::int32_t a = localId[o[0]], b = localId[o[1]];
+        std::int32_t& at = pairCount[std::min(a, b) * L + std::max(a, b)];
+        if (at >= 0) {
+          ++faces[at].count;
+        } else {
+          at = static_cast<std::int32_t>(faces.size());
+          faces.push_back({o[0], o[1], (pos(i1) - pos(i0)).cross(pos(i2) - pos(i0)), 1});
+        }
       }
     }
+    for (int w : nbrs) localId[w] = -1;
     Vec3 sum = Vec3::Zero();
     bool boundary = false, allCut = true;
     for (const auto& bf : faces) {
@@ -267,8 +285,6 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   // the mesh stays manifold: the boundary faces around each of its nodes still form one
   // closed loop (a disc), or the node had no other tet (it goes with the sliver). Its volume (tiny: it is flat) is lost.
   std::vector<std::int32_t> link;  // scratch: link edges of a node, as pairs
-  // Scratch for discAround: v's neighbours, their local numbers (-1 elsewhere), pair counts.
-  std::vector<std::int32_t> nbrs, localId(N, -1), pairCount;
   auto boundaryFaceCount = [&](int t) {
     int count = 0;
     for (int f = 0; f < 4; ++f) {
@@ -450,13 +466,16 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       for (int t : seen) {
         if ((*dead)[t]) continue;
         const double q = tetQ(t);
-        double mean = 0;
-        for (int a = 0; a < 4; ++a)
-          for (int b = a + 1; b < 4; ++b) mean += (pos(mesh.T(t, a)) - pos(mesh.T(t, b))).norm() / 6.0;
-        for (int a = 0; a < 4; ++a)
-          for (int b = a + 1; b < 4; ++b) {
+        double mean = 0, lens[6];
+        for (int a = 0, e = 0; a < 4; ++a)
+          for (int b = a + 1; b < 4; ++b, ++e) {
+            lens[e] = (pos(mesh.T(t, a)) - pos(mesh.T(t, b))).norm();
+            mean += lens[e] / 6.0;
+          }
+        for (int a = 0, e = 0; a < 4; ++a)
+          for (int b = a + 1; b < 4; ++b, ++e) {
             const int x = mesh.T(t, a), y = mesh.T(t, b);
-            const double len = (pos(x) - pos(y)).norm();
+            const double len = lens[e];
             const bool shortEdge = len < options.collapse_fraction * std::max(mean, region.edge_length);
             if (!shortEdge && q >= options.quality_target) continue;
             if (onCut[y]) cands.push_back({len, x, y, shortEdge});
