@@ -42,9 +42,11 @@ struct FaceKeyHash {
   }
 };
 FaceKey makeFace(std::int32_t a, std::int32_t b, std::int32_t c) {
-  FaceKey k{{a, b, c}};
-  std::sort(k.v.begin(), k.v.end());
-  return k;
+  // Sorted (three compare-exchanges).
+  if (a > b) std::swap(a, b);
+  if (b > c) std::swap(b, c);
+  if (a > b) std::swap(a, b);
+  return FaceKey{{a, b, c}};
 }
 
 // Outward faces of a positive tet, by the local index of the opposite vertex.
@@ -288,35 +290,63 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
     std::int32_t u, v;
     Vec3 normal;
   };
+  // The topology does not change before the subdivision (step 3), where the last call is:
+  // the faces found for a node (three corners in the first tet's orientation, and the other
+  // two nodes) are kept, and the normals come from the current positions.
+  struct BFaceTopo {
+    std::int32_t i0, i1, i2, u, v;
+  };
+  std::vector<std::int32_t> bfStart(N0, -1), bfCount(N0, 0);
+  std::vector<BFaceTopo> bfPool;
+  struct Seen {
+    std::int32_t u, v, i0, i1, i2, count;
+  };
+  std::vector<Seen> seenFaces;
+  std::vector<std::int32_t> bfNbrs, bfLocal(N0, -1), faceAt;
   auto boundaryFacesOf = [&](int n) {
-    std::vector<std::pair<FaceKey, Vec3>> faces;
-    std::vector<int> count;
-    for (int s = starOff[n]; s < starOff[n + 1]; ++s) {
-      const Tet tv = w.tet(starTet[s]);
-      const int ln = findLocal(tv, n);
-      for (int f = 0; f < 4; ++f) {
-        if (f == ln) continue;
-        const int i0 = tv[kFace[f][0]], i1 = tv[kFace[f][1]], i2 = tv[kFace[f][2]];
-        const FaceKey key = makeFace(i0, i1, i2);
-        bool found = false;
-        for (size_t q = 0; q < faces.size(); ++q)
-          if (faces[q].first == key) {
-            ++count[q];
-            found = true;
+    if (bfStart[n] < 0) {
+      seenFaces.clear();
+      // Local numbers of n's neighbours; faceAt: (pair of them) -> index in seenFaces.
+      bfNbrs.clear();
+      for (int s = starOff[n]; s < starOff[n + 1]; ++s)
+        for (const int v : w.tet(starTet[s]))
+          if (v != n && bfLocal[v] < 0) {
+            bfLocal[v] = static_cast<std::int32_t>(bfNbrs.size());
+            bfNbrs.push_back(v);
           }
-        if (!found) {
-          faces.emplace_back(key, (w.x(i1) - w.x(i0)).cross(w.x(i2) - w.x(i0)));
-          count.push_back(1);
+      const size_t L = bfNbrs.size();
+      faceAt.assign(L * L, -1);
+      for (int s = starOff[n]; s < starOff[n + 1]; ++s) {
+        const Tet tv = w.tet(starTet[s]);
+        const int ln = findLocal(tv, n);
+        for (int f = 0; f < 4; ++f) {
+          if (f == ln) continue;
+          const int i0 = tv[kFace[f][0]], i1 = tv[kFace[f][1]], i2 = tv[kFace[f][2]];
+          std::int32_t o[2], m = 0;
+          for (int v : {i0, i1, i2})
+            if (v != n) o[m++] = v;
+          if (o[0] > o[1]) std::swap(o[0], o[1]);
+          const std::int32_t a = bfLocal[o[0]], b = bfLocal[o[1]];
+          std::int32_t& at = faceAt[std::min(a, b) * L + std::max(a, b)];
+          if (at >= 0) {
+            ++seenFaces[at].count;
+          } else {
+            at = static_cast<std::int32_t>(seenFaces.size());
+            seenFaces.push_back({o[0], o[1], i0, i1, i2, 1});
+          }
         }
       }
+      for (int v : bfNbrs) bfLocal[v] = -1;
+      bfStart[n] = static_cast<std::int32_t>(bfPool.size());
+      for (const auto& q : seenFaces)
+        if (q.count == 1) bfPool.push_back({q.i0, q.i1, q.i2, q.u, q.v});
+      bfCount[n] = static_cast<std::int32_t>(bfPool.size()) - bfStart[n];
     }
     std::vector<BFace> out;
-    for (size_t q = 0; q < faces.size(); ++q) {
-      if (count[q] != 1) continue;
-      std::int32_t o[2], m = 0;
-      for (int v : faces[q].first.v)
-        if (v != n) o[m++] = v;
-      out.push_back({o[0], o[1], faces[q].second.normalized()});
+    out.reserve(bfCount[n]);
+    for (int q = bfStart[n]; q < bfStart[n] + bfCount[n]; ++q) {
+      const BFaceTopo& f = bfPool[q];
+      out.push_back({f.u, f.v, Vec3((w.x(f.i1) - w.x(f.i0)).cross(w.x(f.i2) - w.x(f.i0))).normalized()});
     }
     return out;
   };
@@ -790,7 +820,7 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
     }
     const size_t numCut = cutNodes.size();
     std::vector<int> parent;
-    std::vector<std::pair<FaceKey, int>> faceOwner;
+    std::vector<std::int32_t> sepLocal, sepNbrs, firstTet;
     for (size_t i = 0; i < numCut; ++i) {
       const int n = cutNodes[i];
       auto& st = star[i];
@@ -801,20 +831,36 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
         while (parent[x] != x) x = parent[x] = parent[parent[x]];
         return x;
       };
-      faceOwner.clear();
+      // Tets sharing a face with n that is not cut are in one group: faces by the pair of
+      // their other two nodes (local numbers over n's neighbours), the first tet seen for each.
+      if (sepLocal.size() < static_cast<size_t>(w.numNodes())) sepLocal.resize(w.numNodes(), -1);
+      sepNbrs.clear();
+      for (int t : st)
+        for (const int v : w.tet(t))
+          if (v != n && sepLocal[v] < 0) {
+            sepLocal[v] = static_cast<std::int32_t>(sepNbrs.size());
+            sepNbrs.push_back(v);
+          }
+      const size_t L = sepNbrs.size();
+      firstTet.assign(L * L, -1);
       for (size_t j = 0; j < st.size(); ++j) {
         const Tet tv = w.tet(st[j]);
         const int ln = findLocal(tv, n);
         for (int f = 0; f < 4; ++f) {
           if (f == ln) continue;
-          faceOwner.emplace_back(makeFace(tv[kFace[f][0]], tv[kFace[f][1]], tv[kFace[f][2]]), static_cast<int>(j));
+          std::int32_t o[2], m = 0;
+          for (int k = 0; k < 3; ++k)
+            if (tv[kFace[f][k]] != n) o[m++] = tv[kFace[f][k]];
+          const std::int32_t a = sepLocal[o[0]], b = sepLocal[o[1]];
+          std::int32_t& first = firstTet[std::min(a, b) * L + std::max(a, b)];
+          if (first < 0) {
+            first = static_cast<std::int32_t>(j);
+          } else if (!cutFaces.count(makeFace(n, o[0], o[1]))) {
+            parent[find(first)] = find(static_cast<int>(j));
+          }
         }
       }
-      std::sort(faceOwner.begin(), faceOwner.end(),
-                [](const std::pair<FaceKey, int>& x, const std::pair<FaceKey, int>& y) { return x.first < y.first; });
-      for (size_t q = 0; q + 1 < faceOwner.size(); ++q)
-        if (faceOwner[q].first == faceOwner[q + 1].first && !cutFaces.count(faceOwner[q].first))
-          parent[find(faceOwner[q].second)] = find(faceOwner[q + 1].second);
+      for (int v : sepNbrs) sepLocal[v] = -1;
       // The group of the first tet keeps n; every other group gets a copy.
       std::vector<int> copyOf(st.size(), -1);
       const int keep = find(0);

@@ -14,6 +14,8 @@
 // node in its worst element; each tried at decreasing lengths) are kept only if no incident
 // tet inverts and the worst incident q* rises: the local minimum quality never drops.
 #include <algorithm>
+#include <array>
+#include <bit>
 #include <cmath>
 #include <vector>
 
@@ -44,29 +46,104 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   std::vector<std::uint8_t> onCut = region.on_cut;  // grows: nodes snapped onto the cut here
   const double cosFlat = std::cos(options.boundary_flat_deg * M_PI / 180.0);
 
-  // Node -> tets of the whole mesh (one O(#T) pass; everything else is local).
-  // Rebuilt after edge collapses (live tets only).
+  // Node -> tets of the whole mesh (one O(#T) pass; everything else is local), live tets in
+  // index order. After edge collapses the lists of the nodes whose tets died or changed are
+  // rebuilt (buildStars), into `ovrPool`; the others keep their CSR rows.
   std::vector<std::int32_t> off(N + 1, 0), star(4 * static_cast<size_t>(M));
+  std::vector<std::int32_t> ovrStart(N, -1), ovrLen(N, 0), ovrPool;
+  std::vector<std::uint8_t> touched(N, 0);
+  std::vector<std::int32_t> touchedList;
+  std::vector<std::pair<std::int32_t, std::int32_t>> gained;  // (node, tet): tet took the node
+  auto starB = [&](int n) -> const std::int32_t* {
+    return ovrStart[n] >= 0 ? ovrPool.data() + ovrStart[n] : star.data() + off[n];
+  };
+  auto starE = [&](int n) -> const std::int32_t* {
+    return ovrStart[n] >= 0 ? ovrPool.data() + ovrStart[n] + ovrLen[n] : star.data() + off[n + 1];
+  };
+  auto touch = [&](int n) {
+    if (!touched[n]) {
+      touched[n] = 1;
+      touchedList.push_back(n);
+    }
+  };
+  auto kill = [&](int t) {
+    (*dead)[t] = 1;
+    for (int k = 0; k < 4; ++k) touch(mesh.T(t, k));
+  };
+  bool built = false;
+  std::vector<std::int32_t> scratch;
   auto buildStars = [&]() {
-    std::fill(off.begin(), off.end(), 0);
-    for (int t = 0; t < M; ++t)
-      if (!(*dead)[t])
-        for (int k = 0; k < 4; ++k) ++off[mesh.T(t, k) + 1];
-    for (int i = 0; i < N; ++i) off[i + 1] += off[i];
-    std::vector<std::int32_t> fill(off.begin(), off.end() - 1);
-    for (int t = 0; t < M; ++t)
-      if (!(*dead)[t])
-        for (int k = 0; k < 4; ++k) star[fill[mesh.T(t, k)]++] = t;
+    if (!built) {
+      built = true;
+      for (int t = 0; t < M; ++t)
+        if (!(*dead)[t])
+          for (int k = 0; k < 4; ++k) ++off[mesh.T(t, k) + 1];
+      for (int i = 0; i < N; ++i) off[i + 1] += off[i];
+      std::vector<std::int32_t> fill(off.begin(), off.end() - 1);
+      for (int t = 0; t < M; ++t)
+        if (!(*dead)[t])
+          for (int k = 0; k < 4; ++k) star[fill[mesh.T(t, k)]++] = t;
+      return;
+    }
+    // The same lists as a full rebuild: live tets with the node, in index order.
+    std::sort(gained.begin(), gained.end());
+    for (int n : touchedList) {
+      scratch.assign(starB(n), starE(n));
+      auto g = std::lower_bound(gained.begin(), gained.end(), std::make_pair(static_cast<std::int32_t>(n), std::int32_t{-1}));
+      for (; g != gained.end() && g->first == n; ++g) scratch.push_back(g->second);
+      std::sort(scratch.begin(), scratch.end());
+      scratch.erase(std::unique(scratch.begin(), scratch.end()), scratch.end());
+      ovrStart[n] = static_cast<std::int32_t>(ovrPool.size());
+      for (int t : scratch) {
+        if ((*dead)[t]) continue;
+        bool has = false;
+        for (int k = 0; k < 4; ++k) has = has || mesh.T(t, k) == n;
+        if (has) ovrPool.push_back(t);
+      }
+      ovrLen[n] = static_cast<std::int32_t>(ovrPool.size()) - ovrStart[n];
+      touched[n] = 0;
+    }
+    touchedList.clear();
+    gained.clear();
   };
   buildStars();
   // Peeling and collapses change the volume; together they may change it by at most
   // volume_budget of the mesh's volume.
   double budget = 0;
-  for (int t = 0; t < M; ++t) budget += tetVolume(mesh, t);
+  for (int t = 0; t < M; ++t) {
+    // tetVolume, inline.
+    const Vec3 x0 = mesh.X.row(mesh.T(t, 0)), x1 = mesh.X.row(mesh.T(t, 1)), x2 = mesh.X.row(mesh.T(t, 2)),
+               x3 = mesh.X.row(mesh.T(t, 3));
+    budget += (x1 - x0).dot((x2 - x0).cross(x3 - x0)) / 6.0;
+  }
   budget *= options.volume_budget;
   auto pos = [&](int i) -> Vec3 { return mesh.X.row(i).transpose(); };
+  // q* of tet t, cached per tet with the node indices and positions it was computed from
+  // (a hit needs all of them unchanged, so the value is exactly what radiusRatio returns).
+  struct QEntry {
+    std::int32_t v[4];
+    double x[12];
+    double q;
+  };
+  std::vector<std::int32_t> qSlot(M, -1);
+  std::vector<QEntry> qPool;
   auto tetQ = [&](int t) {
-    return radiusRatio(pos(mesh.T(t, 0)), pos(mesh.T(t, 1)), pos(mesh.T(t, 2)), pos(mesh.T(t, 3)));
+    QEntry cur;
+    for (int k = 0; k < 4; ++k) {
+      cur.v[k] = mesh.T(t, k);
+      for (int a = 0; a < 3; ++a) cur.x[3 * k + a] = mesh.X(cur.v[k], a);
+    }
+    std::int32_t& slot = qSlot[t];
+    if (slot >= 0) {
+      const QEntry& e = qPool[slot];
+      if (std::equal(cur.v, cur.v + 4, e.v) && std::equal(cur.x, cur.x + 12, e.x)) return e.q;
+    } else {
+      slot = static_cast<std::int32_t>(qPool.size());
+      qPool.emplace_back();
+    }
+    cur.q = radiusRatio(pos(cur.v[0]), pos(cur.v[1]), pos(cur.v[2]), pos(cur.v[3]));
+    qPool[slot] = cur;
+    return cur.q;
   };
   // Quality of tet t with node n placed at y; negative when it would invert or go flat.
   auto tetQAt = [&](int t, int n, const Vec3& y) {
@@ -75,19 +152,40 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     if (!((p[1] - p[0]).dot((p[2] - p[0]).cross(p[3] - p[0])) > 0)) return -1.0;
     return radiusRatio(p[0], p[1], p[2], p[3]);
   };
-  auto starWorst = [&](int n, const Vec3& y, int* worstTet) {
+  // Worst q* around n where it is (tetQAt at its own position, through the cache).
+  auto starWorst = [&](int n, int* worstTet) {
     double q = 1.0;
-    for (int s = off[n]; s < off[n + 1]; ++s) {
-      if ((*dead)[star[s]]) continue;
-      const double qt = tetQAt(star[s], n, y);
+    for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s) {
+      const int t = (*s);
+      if ((*dead)[t]) continue;
+      const Vec3 p0 = pos(mesh.T(t, 0)), p1 = pos(mesh.T(t, 1)), p2 = pos(mesh.T(t, 2)), p3 = pos(mesh.T(t, 3));
+      const double qt = (p1 - p0).dot((p2 - p0).cross(p3 - p0)) > 0 ? tetQ(t) : -1.0;
       if (qt < q) {
         q = qt;
-        if (worstTet) *worstTet = star[s];
+        if (worstTet) *worstTet = (*s);
         if (qt < 0) return qt;
       }
     }
     return q;
   };
+  // Is the worst q* around n with n at y above `floor`? Tet `first` (the likely worst) is
+  // tried first and the scan stops at the first tet at or below the floor; when it passes,
+  // *q receives the worst q* (as starWorst).
+  auto starAbove = [&](int n, const Vec3& y, int first, double floor, double* q) {
+    double worst = tetQAt(first, n, y);
+    if (!(worst > floor)) return false;
+    for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s) {
+      if ((*s) == first || (*dead)[(*s)]) continue;
+      const double qt = tetQAt((*s), n, y);
+      if (!(qt > floor)) return false;
+      worst = std::min(worst, qt);
+    }
+    *q = std::min(1.0, worst);
+    return true;
+  };
+  // Scratch for constraintOf and discAround: a node's neighbours, their local numbers (-1
+  // elsewhere), a table over pairs of them.
+  std::vector<std::int32_t> nbrs, localId(N, -1), pairCount;
   // Where node n may move (see the file comment).
   struct BFace {
     std::int32_t u, v;
@@ -98,8 +196,21 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   auto constraintOf = [&](int n) {
     Constraint c;
     faces.clear();
-    for (int s = off[n]; s < off[n + 1]; ++s) {
-      const int t = star[s];
+    // Faces by the pair of their nodes other than n (local numbers over n's neighbours).
+    nbrs.clear();
+    for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s)
+      if (!(*dead)[*s])
+        for (int k = 0; k < 4; ++k) {
+          const int w = mesh.T(*s, k);
+          if (w != n && localId[w] < 0) {
+            localId[w] = static_cast<std::int32_t>(nbrs.size());
+            nbrs.push_back(w);
+          }
+        }
+    const size_t L = nbrs.size();
+    pairCount.assign(L * L, -1);  // index into faces
+    for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s) {
+      const int t = (*s);
       if ((*dead)[t]) continue;
       int ln = 0;
       while (mesh.T(t, ln) != n) ++ln;
@@ -110,15 +221,17 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
         for (int v : {i0, i1, i2})
           if (v != n) o[m++] = v;
         if (o[0] > o[1]) std::swap(o[0], o[1]);
-        bool found = false;
-        for (auto& bf : faces)
-          if (bf.u == o[0] && bf.v == o[1]) {
-            ++bf.count;
-            found = true;
-          }
-        if (!found) faces.push_back({o[0], o[1], (pos(i1) - pos(i0)).cross(pos(i2) - pos(i0)), 1});
+        const std::int32_t a = localId[o[0]], b = localId[o[1]];
+        std::int32_t& at = pairCount[std::min(a, b) * L + std::max(a, b)];
+        if (at >= 0) {
+          ++faces[at].count;
+        } else {
+          at = static_cast<std::int32_t>(faces.size());
+          faces.push_back({o[0], o[1], (pos(i1) - pos(i0)).cross(pos(i2) - pos(i0)), 1});
+        }
       }
     }
+    for (int w : nbrs) localId[w] = -1;
     Vec3 sum = Vec3::Zero();
     bool boundary = false, allCut = true;
     for (const auto& bf : faces) {
@@ -177,8 +290,8 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     for (int f = 0; f < 4; ++f) {
       const int a = mesh.T(t, kFace[f][0]), b = mesh.T(t, kFace[f][1]), c = mesh.T(t, kFace[f][2]);
       bool shared = false;
-      for (int s = off[a]; s < off[a + 1] && !shared; ++s) {
-        const int u = star[s];
+      for (const std::int32_t *s = starB(a), *sEnd = starE(a); s < sEnd && !shared; ++s) {
+        const int u = (*s);
         if (u == t || (*dead)[u]) continue;
         int hits = 0;
         for (int k = 0; k < 4; ++k) hits += mesh.T(u, k) == b || mesh.T(u, k) == c;
@@ -191,8 +304,8 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   // The tets around v (live ones from the node->tet lists, plus `extra`).
   auto liveStar = [&](int v, std::vector<std::int32_t>& out, const std::vector<std::int32_t>* extra) {
     out.clear();
-    for (int s = off[v]; s < off[v + 1]; ++s)
-      if (!(*dead)[star[s]]) out.push_back(star[s]);
+    for (const std::int32_t *s = starB(v), *sEnd = starE(v); s < sEnd; ++s)
+      if (!(*dead)[(*s)]) out.push_back((*s));
     if (extra)
       for (int t : *extra)
         if (!(*dead)[t]) out.push_back(t);
@@ -203,7 +316,29 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   auto discAround = [&](int v, const std::vector<std::int32_t>& around) {
     link.clear();
     if (around.empty()) return true;
+    // Every tet of `around` has v; a face (v, a, b) is used by the tets with both a and b:
+    // count the pairs of each tet's other three nodes in a table over v's neighbours.
+    nbrs.clear();
+    for (int t : around)
+      for (int k = 0; k < 4; ++k) {
+        const int w = mesh.T(t, k);
+        if (w != v && localId[w] < 0) {
+          localId[w] = static_cast<std::int32_t>(nbrs.size());
+          nbrs.push_back(w);
+        }
+      }
+    const size_t L = nbrs.size();
+    pairCount.assign(L * L, 0);
     for (int t : around) {
+      std::int32_t o[3], m = 0;
+      for (int k = 0; k < 4; ++k)
+        if (mesh.T(t, k) != v && m < 3) o[m++] = localId[mesh.T(t, k)];
+      for (int i = 0; i < m; ++i)
+        for (int j = i + 1; j < m; ++j) ++pairCount[std::min(o[i], o[j]) * L + std::max(o[i], o[j])];
+    }
+    bool manifold = true;
+    for (size_t i = 0; i < around.size() && manifold; ++i) {
+      const int t = around[i];
       int lv = 0;
       while (mesh.T(t, lv) != v) ++lv;
       for (int f = 0; f < 4; ++f) {
@@ -211,19 +346,20 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
         std::int32_t o[2], m = 0;
         for (int k = 0; k < 3; ++k)
           if (mesh.T(t, kFace[f][k]) != v) o[m++] = mesh.T(t, kFace[f][k]);
-        int uses = 0;
-        for (int u : around) {
-          int hits = 0;
-          for (int k = 0; k < 4; ++k) hits += mesh.T(u, k) == o[0] || mesh.T(u, k) == o[1];
-          uses += hits == 2;
+        const std::int32_t a = localId[o[0]], b = localId[o[1]];
+        const int uses = pairCount[std::min(a, b) * L + std::max(a, b)];
+        if (uses > 2) {
+          manifold = false;
+          break;
         }
-        if (uses > 2) return false;
         if (uses == 1) {
           link.push_back(o[0]);
           link.push_back(o[1]);
         }
       }
     }
+    for (int w : nbrs) localId[w] = -1;
+    if (!manifold) return false;
     if (link.empty()) return true;  // interior node
     // One closed loop: every link vertex has degree 2, and walking from one edge visits all.
     const size_t edges = link.size() / 2;
@@ -249,19 +385,29 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   std::vector<std::int32_t> around;
   std::vector<std::int32_t> lateSnapped;  // nodes snapNear moved onto the cut
   // The live tets around the seeds, each once, in index order.
-  std::vector<std::int32_t> tetMark(M, -1);
-  int markRound = 0;
+  // A bit per tet: set while collecting, read back word by word (index order), cleared.
+  std::vector<std::uint64_t> tetBits(static_cast<size_t>(M) / 64 + 1, 0);
+  std::vector<std::int32_t> bitWords;
   auto regionTets = [&](std::vector<std::int32_t>& out) {
-    ++markRound;
     out.clear();
+    bitWords.clear();
     for (int n : region.seeds)
-      for (int s = off[n]; s < off[n + 1]; ++s) {
-        const int t = star[s];
-        if ((*dead)[t] || tetMark[t] == markRound) continue;
-        tetMark[t] = markRound;
-        out.push_back(t);
+      for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s) {
+        const int t = (*s);
+        if ((*dead)[t]) continue;
+        std::uint64_t& word = tetBits[static_cast<size_t>(t) >> 6];
+        if (word == 0) bitWords.push_back(t >> 6);
+        word |= std::uint64_t{1} << (t & 63);
       }
-    std::sort(out.begin(), out.end());
+    std::sort(bitWords.begin(), bitWords.end());
+    for (int wi : bitWords) {
+      std::uint64_t word = tetBits[wi];
+      tetBits[wi] = 0;
+      while (word) {
+        out.push_back(wi * 64 + std::countr_zero(word));
+        word &= word - 1;
+      }
+    }
   };
   auto peel = [&]() {
     if (!(options.peel_quality > 0)) return;
@@ -274,7 +420,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       again = false;
       for (int t : candidates) {
         if ((*dead)[t] || boundaryFaceCount(t) == 0 || tetVolume(mesh, t) > budget) continue;
-        (*dead)[t] = 1;
+        kill(t);
         bool ok = true;
         for (int k = 0; k < 4 && ok; ++k) {
           liveStar(mesh.T(t, k), around, nullptr);
@@ -306,7 +452,8 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   auto collapseEdges = [&]() {
     if (!(options.collapse_fraction > 0)) return;
     std::vector<std::uint8_t> locked(N, 0);
-    std::vector<std::int32_t> dying, changing, vstar, keyA, keyB;
+    std::vector<std::int32_t> dying, changing, vstar, checked;
+    std::vector<std::array<std::int32_t, 4>> keysB;
     struct Cand {
       double len;
       std::int32_t u, v;
@@ -319,13 +466,16 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       for (int t : seen) {
         if ((*dead)[t]) continue;
         const double q = tetQ(t);
-        double mean = 0;
-        for (int a = 0; a < 4; ++a)
-          for (int b = a + 1; b < 4; ++b) mean += (pos(mesh.T(t, a)) - pos(mesh.T(t, b))).norm() / 6.0;
-        for (int a = 0; a < 4; ++a)
-          for (int b = a + 1; b < 4; ++b) {
+        double mean = 0, lens[6];
+        for (int a = 0, e = 0; a < 4; ++a)
+          for (int b = a + 1; b < 4; ++b, ++e) {
+            lens[e] = (pos(mesh.T(t, a)) - pos(mesh.T(t, b))).norm();
+            mean += lens[e] / 6.0;
+          }
+        for (int a = 0, e = 0; a < 4; ++a)
+          for (int b = a + 1; b < 4; ++b, ++e) {
             const int x = mesh.T(t, a), y = mesh.T(t, b);
-            const double len = (pos(x) - pos(y)).norm();
+            const double len = lens[e];
             const bool shortEdge = len < options.collapse_fraction * std::max(mean, region.edge_length);
             if (!shortEdge && q >= options.quality_target) continue;
             if (onCut[y]) cands.push_back({len, x, y, shortEdge});
@@ -341,24 +491,25 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
         if (locked[u] || locked[v]) continue;
         dying.clear();
         changing.clear();
-        double oldMin = 1.0, newMin = 1.0;
-        for (int s = off[u]; s < off[u + 1]; ++s) {
-          const int t = star[s];
+        for (const std::int32_t *s = starB(u), *sEnd = starE(u); s < sEnd; ++s) {
+          const int t = (*s);
           if ((*dead)[t]) continue;
           bool hasV = false;
           for (int k = 0; k < 4; ++k) hasV = hasV || mesh.T(t, k) == v;
           (hasV ? dying : changing).push_back(t);
-          oldMin = std::min(oldMin, tetQ(t));
         }
         if (dying.empty()) continue;  // not an edge any more
+        // Checks in order of cost (all must pass): no changed tet inverts or goes flat, the
+        // volume changes within the limits, the worst q* rises (short edges: does not fall).
         bool ok = true;
+        const Vec3 xv = pos(v);
         for (int t : changing) {
-          const double q = tetQAt(t, u, pos(v));
-          if (q < 0) {
+          Vec3 p[4];
+          for (int k = 0; k < 4; ++k) p[k] = mesh.T(t, k) == u ? xv : pos(mesh.T(t, k));
+          if (!((p[1] - p[0]).dot((p[2] - p[0]).cross(p[3] - p[0])) > 0)) {
             ok = false;
             break;
           }
-          newMin = std::min(newMin, q);
         }
         if (!ok) continue;
         // Volume: the removed tets and the change of the others, against u's star.
@@ -372,32 +523,55 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
         }
         const double change = std::abs(after - before);
         if (change > options.collapse_volume_fraction * before || change > budget) continue;
-        if (c.shortEdge ? newMin < oldMin : !(newMin > oldMin)) continue;
+        double oldMin = 1.0;
+        for (int t : dying) oldMin = std::min(oldMin, tetQ(t));
+        for (int t : changing) oldMin = std::min(oldMin, tetQ(t));
+        // newMin = the worst q* after; stop as soon as it fails against oldMin.
+        double newMin = 1.0;
+        for (int t : changing) {
+          newMin = std::min(newMin, tetQAt(t, u, xv));
+          if (c.shortEdge ? newMin < oldMin : !(newMin > oldMin)) {
+            ok = false;
+            break;
+          }
+        }
+        if (!ok || (c.shortEdge ? newMin < oldMin : !(newMin > oldMin))) continue;
         // No changed tet may coincide with a tet already around v.
         liveStar(v, vstar, nullptr);
-        for (int t : changing) {
-          keyA.assign({mesh.T(t, 0), mesh.T(t, 1), mesh.T(t, 2), mesh.T(t, 3)});
-          std::replace(keyA.begin(), keyA.end(), u, v);
-          std::sort(keyA.begin(), keyA.end());
-          for (int w : vstar) {
-            if (std::find(dying.begin(), dying.end(), w) != dying.end()) continue;
-            keyB.assign({mesh.T(w, 0), mesh.T(w, 1), mesh.T(w, 2), mesh.T(w, 3)});
-            std::sort(keyB.begin(), keyB.end());
-            if (keyA == keyB) ok = false;
-          }
+        keysB.clear();
+        for (int w : vstar) {
+          if (std::find(dying.begin(), dying.end(), w) != dying.end()) continue;
+          std::array<std::int32_t, 4> k{mesh.T(w, 0), mesh.T(w, 1), mesh.T(w, 2), mesh.T(w, 3)};
+          std::sort(k.begin(), k.end());
+          keysB.push_back(k);
+        }
+        for (size_t i = 0; i < changing.size() && ok; ++i) {
+          const int t = changing[i];
+          std::array<std::int32_t, 4> k{mesh.T(t, 0), mesh.T(t, 1), mesh.T(t, 2), mesh.T(t, 3)};
+          std::replace(k.begin(), k.end(), u, v);
+          std::sort(k.begin(), k.end());
+          for (const auto& kb : keysB)
+            if (k == kb) ok = false;
         }
         if (!ok) continue;
         // Apply, check manifoldness around v and the other nodes of the removed tets, or undo.
-        for (int t : dying) (*dead)[t] = 1;
-        for (int t : changing)
+        for (int t : dying) kill(t);
+        touch(u);
+        touch(v);
+        for (int t : changing) {
+          gained.emplace_back(v, t);
           for (int k = 0; k < 4; ++k)
             if (mesh.T(t, k) == u) mesh.T(t, k) = v;
+        }
         liveStar(v, around, &changing);
         ok = discAround(v, around);
+        // (Each node once: the nodes around the edge are in two of the removed tets.)
+        checked.clear();
         for (size_t i = 0; i < dying.size() && ok; ++i)
           for (int k = 0; k < 4 && ok; ++k) {
             const int w = mesh.T(dying[i], k);
-            if (w == u || w == v) continue;
+            if (w == u || w == v || std::find(checked.begin(), checked.end(), w) != checked.end()) continue;
+            checked.push_back(w);
             liveStar(w, around, nullptr);
             ok = discAround(w, around);
           }
@@ -451,8 +625,8 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     auto trySnap = [&](int* partner) {
       tets.clear();
       for (int g : group)
-        for (int s = off[g]; s < off[g + 1]; ++s)
-          if (!(*dead)[star[s]]) tets.push_back(star[s]);
+        for (const std::int32_t *s = starB(g), *sEnd = starE(g); s < sEnd; ++s)
+          if (!(*dead)[(*s)]) tets.push_back((*s));
       std::sort(tets.begin(), tets.end());
       tets.erase(std::unique(tets.begin(), tets.end()), tets.end());
       dying.clear();
@@ -499,7 +673,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
         groupFrom.push_back(pos(group[g]));
         mesh.X.row(group[g]) = groupTo[g].transpose();
       }
-      for (int t : dying) (*dead)[t] = 1;
+      for (int t : dying) kill(t);
       bool ok = true;
       for (size_t g = 0; g < group.size() && ok; ++g) {
         liveStar(group[g], around, nullptr);
@@ -533,8 +707,8 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       targets.clear();
       targets.emplace_back();
       region.surface->signedDistance(pos(u), &targets.back());
-      for (int s = off[u]; s < off[u + 1]; ++s) {
-        const int t = star[s];
+      for (const std::int32_t *s = starB(u), *sEnd = starE(u); s < sEnd; ++s) {
+        const int t = (*s);
         if ((*dead)[t]) continue;
         for (int i = 0; i < 4; ++i)
           for (int j = i + 1; j < 4; ++j) {
@@ -585,9 +759,9 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     for (int r = 1; r <= options.rings && !frontier.empty(); ++r) {
       next.clear();
       for (int n : frontier)
-        for (int s = off[n]; s < off[n + 1]; ++s)
+        for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s)
           for (int k = 0; k < 4; ++k) {
-            const int v = mesh.T(star[s], k);
+            const int v = mesh.T((*s), k);
             if (ring[v] < 0) {
               ring[v] = static_cast<std::int8_t>(r);
               next.push_back(v);
@@ -599,8 +773,8 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   // Work list: the nodes of poor elements around the seeds.
   std::vector<std::int32_t> stamp(N, -1), work;
   auto addBadAround = [&](int n, int round) {
-    for (int s = off[n]; s < off[n + 1]; ++s) {
-      const int t = star[s];
+    for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s) {
+      const int t = (*s);
       if ((*dead)[t] || tetQ(t) >= options.quality_target) continue;
       for (int k = 0; k < 4; ++k) {
         const int v = mesh.T(t, k);
@@ -624,7 +798,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       if (c.kind == Freedom::Fixed) continue;
       const Vec3 x = pos(n);
       int wt = -1;
-      const double before = starWorst(n, x, &wt);
+      const double before = starWorst(n, &wt);
       if (before < 0 || before >= options.quality_target || wt < 0) continue;
       auto project = [&](Vec3 d) {
         if (c.kind == Freedom::Plane || c.kind == Freedom::Surface) d -= d.dot(c.normal) * c.normal;
@@ -640,9 +814,9 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       double sum = 0;
       int deg = 0;
       Vec3 force = Vec3::Zero();
-      for (int s = off[n]; s < off[n + 1]; ++s)
-        for (int k = 0; k < 4 && !(*dead)[star[s]]; ++k) {
-          const int m = mesh.T(star[s], k);
+      for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s)
+        for (int k = 0; k < 4 && !(*dead)[(*s)]; ++k) {
+          const int m = mesh.T((*s), k);
           if (m == n) continue;
           sum += (pos(m) - x).norm();
           ++deg;
@@ -650,9 +824,9 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       if (deg == 0) continue;
       const double h = sum / deg;
       scale = std::max(scale, h);
-      for (int s = off[n]; s < off[n + 1]; ++s)
-        for (int k = 0; k < 4 && !(*dead)[star[s]]; ++k) {
-          const int m = mesh.T(star[s], k);
+      for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s)
+        for (int k = 0; k < 4 && !(*dead)[(*s)]; ++k) {
+          const int m = mesh.T((*s), k);
           if (m == n) continue;
           const Vec3 d = pos(m) - x;
           const double len = d.norm();
@@ -687,8 +861,8 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
           Vec3 y = x + step * d;
           if (c.kind == Freedom::Surface) region.surface->signedDistance(Vec3(y), &y);
           if (!sideKept(n, x, y)) continue;
-          const double q = starWorst(n, y, nullptr);
-          if (q > best) {
+          double q = 0;
+          if (starAbove(n, y, wt, best, &q)) {
             best = q;
             bestX = y;
             break;
