@@ -123,6 +123,64 @@ BENCHMARK(BM_Cut3DUpdate)
     ->Repetitions(5)
     ->ReportAggregatesOnly(true);
 
+// The cut with the incremental update the simulator uses after each pass
+// (sim::updateModelAfterCut3D: masses and springs recomputed around the cut only, a Lanczos
+// estimate of the stable substep; sim::remapState3D). Same counters as BM_Cut3DUpdate. The
+// model is copied before each iteration (the update works in place) with the timer paused.
+void BM_Cut3DIncremental(benchmark::State& state) {
+  const Prepared& p = mesh(static_cast<int>(state.range(0)));
+  const int plane = static_cast<int>(state.range(1));
+  if (!p.ok) {
+    state.SkipWithError("cannot read or model the mesh (assets/uterus_myoma.msh, tests/data/cutting/uterus_20k.msh)");
+    return;
+  }
+  const Vec3 lo = p.mesh.X.colwise().minCoeff().transpose(), hi = p.mesh.X.colwise().maxCoeff().transpose();
+  const auto surface = *hysim::cutting::CutSurface::plane(0.5 * (lo + hi) + kOffsets[plane], kNormals[plane].normalized());
+  double cutMs = 0, optMs = 0, updMs = 0;
+  hysim::sim::Model model;
+  for (auto _ : state) {
+    state.PauseTiming();
+    model = p.model;
+    state.ResumeTiming();
+    const auto t0 = std::chrono::steady_clock::now();
+    auto r = hysim::cutting::cut3d(p.mesh, surface, {});
+    const auto t1 = std::chrono::steady_clock::now();
+    if (!r.ok()) {
+      state.SkipWithError(r.error().c_str());
+      return;
+    }
+    // Anchored after the cut: surviving nodes keep their flag; new nodes (on the cut, inside
+    // the free region here) are free.
+    std::vector<std::uint8_t> fixed(static_cast<size_t>(r->mesh.numNodes()), 0);
+    for (int i = 0; i < p.mesh.numNodes(); ++i) {
+      const int j = r->change.node_old_to_new[i];
+      if (j >= 0) fixed[j] = p.model.fixed[i] ? 1 : 0;
+    }
+    const auto st = hysim::sim::updateModelAfterCut3D(model, p.mesh, r->mesh, r->change, fixed, {});
+    if (!st.ok()) {
+      state.SkipWithError(st.error().c_str());
+      return;
+    }
+    auto s = hysim::sim::remapState3D(p.state, r->change);
+    const auto t2 = std::chrono::steady_clock::now();
+    benchmark::DoNotOptimize(s);
+    cutMs += std::chrono::duration<double, std::milli>(t1 - t0).count();
+    updMs += std::chrono::duration<double, std::milli>(t2 - t1).count();
+    optMs += r->report.optimize_ms;
+  }
+  const double n = static_cast<double>(state.iterations());
+  state.counters["cut_ms"] = cutMs / n;
+  state.counters["optimize_ms"] = optMs / n;
+  state.counters["update_ms"] = updMs / n;
+  state.SetLabel(p.name + " plane " + std::to_string(plane) + " hybrid, incremental update");
+}
+BENCHMARK(BM_Cut3DIncremental)
+    ->ArgsProduct({{0, 1}, {0, 1, 2, 3}})
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(0.2)
+    ->Repetitions(5)
+    ->ReportAggregatesOnly(true);
+
 // The cut alone (cut3d incl. optimisation and TopologyChange), without the tissue update.
 void BM_Cut3D(benchmark::State& state) {
   const Prepared& p = mesh(static_cast<int>(state.range(0)));
