@@ -4,6 +4,7 @@
 #include <assimp/scene.h>
 
 #include <algorithm>
+#include <array>
 #include <assimp/Importer.hpp>
 #include <chrono>
 #include <cmath>
@@ -25,11 +26,175 @@ Eigen::Vector3d closestOnSegment(const Eigen::Vector3d& p, const Eigen::Vector3d
   return a + t * ab;
 }
 
+// The four faces of a tet as local vertex indices, face k opposite vertex k, oriented
+// outwards for a positive tet: the order cutting::boundaryFaces uses.
+constexpr int kTetFace[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
+
+// Face matching of a tet mesh in linear time. Slot s = 4 t + k is face k of tet t; next[s] is
+// another slot with the same three nodes (the slots of a shared face form a cycle), or -1
+// where the face is on the boundary. Faces are bucketed by their smallest node (a counting
+// sort), then sorted by the other two inside each bucket (a few dozen faces). Returns false
+// (next untouched) for node ids outside [0, #N), which a valid mesh never has.
+bool matchFaces(const cutting::TetMesh& mesh, std::vector<int>& next) {
+  const int M = mesh.numTets(), N = mesh.numNodes();
+  const size_t S = 4 * static_cast<size_t>(M);
+  std::vector<std::array<int, 3>> key(S);
+  std::vector<int> start(static_cast<size_t>(N) + 1, 0);
+  for (int t = 0; t < M; ++t)
+    for (int k = 0; k < 4; ++k) {
+      int a = mesh.T(t, kTetFace[k][0]), b = mesh.T(t, kTetFace[k][1]), c = mesh.T(t, kTetFace[k][2]);
+      if (a > b) std::swap(a, b);
+      if (b > c) std::swap(b, c);
+      if (a > b) std::swap(a, b);
+      if (a < 0 || c >= N) return false;
+      key[4 * static_cast<size_t>(t) + k] = {a, b, c};
+      ++start[static_cast<size_t>(a) + 1];
+    }
+  for (int i = 0; i < N; ++i) start[i + 1] += start[i];
+  std::vector<int> order(S), fill(start.begin(), start.end() - 1);
+  for (size_t s = 0; s < S; ++s) order[fill[key[s][0]]++] = static_cast<int>(s);
+  next.assign(S, -1);
+  for (int n = 0; n < N; ++n) {
+    int* const first = order.data() + start[n];
+    int* const last = order.data() + start[n + 1];
+    std::sort(first, last, [&](int x, int y) {
+      if (key[x][1] != key[y][1]) return key[x][1] < key[y][1];
+      if (key[x][2] != key[y][2]) return key[x][2] < key[y][2];
+      return x < y;
+    });
+    for (int* i = first; i < last;) {
+      int* j = i + 1;
+      while (j < last && key[*j][1] == key[*i][1] && key[*j][2] == key[*i][2]) ++j;
+      if (j - i > 1) {
+        for (int* q = i; q + 1 < j; ++q) next[*q] = *(q + 1);
+        next[*(j - 1)] = *i;
+      }
+      i = j;
+    }
+  }
+  return true;
+}
+
+// Connected components through shared faces, numbered in the order of their first tet,
+// and whether each touches no anchored node: cutting::tetComponents' label, count and free
+// (not its volumes), from a face matching.
+struct Pieces {
+  std::vector<int> label;  // #T
+  int count = 0;
+  std::vector<std::uint8_t> free;  // per component
+};
+Pieces tetPieces(const cutting::TetMesh& mesh, const std::vector<int>& next, const std::vector<std::uint8_t>& anchored) {
+  const int M = mesh.numTets();
+  std::vector<int> parent(static_cast<size_t>(M));
+  for (int t = 0; t < M; ++t) parent[t] = t;
+  auto find = [&](int x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+  };
+  for (size_t s = 0; s < next.size(); ++s)
+    if (next[s] >= 0) parent[find(static_cast<int>(s / 4))] = find(next[s] / 4);
+  Pieces c;
+  c.label.assign(static_cast<size_t>(M), -1);
+  std::vector<int> id(static_cast<size_t>(M), -1);
+  for (int t = 0; t < M; ++t) {
+    const int r = find(t);
+    if (id[r] < 0) id[r] = c.count++;
+    c.label[t] = id[r];
+  }
+  c.free.assign(static_cast<size_t>(c.count), 1);
+  for (int t = 0; t < M; ++t)
+    for (int k = 0; k < 4; ++k)
+      if (anchored[mesh.T(t, k)]) c.free[c.label[t]] = 0;
+  return c;
+}
+
+// Nearest point of a set to a query, exactly as a linear scan in the set's order finds it
+// (smallest squared distance, the first such point on ties), through a uniform grid.
+class NearestPoint {
+ public:
+  // pts: indices into x of the candidate points, in scan order.
+  void build(const sim::NodeVectors& x, const std::vector<int>& pts) {
+    pts_ = &pts;
+    x_ = &x;
+    if (pts.empty()) return;
+    Eigen::Vector3d lo = x.row(pts[0]).transpose(), hi = lo;
+    for (int p : pts) {
+      lo = lo.cwiseMin(x.row(p).transpose());
+      hi = hi.cwiseMax(x.row(p).transpose());
+    }
+    const Eigen::Vector3d ext = (hi - lo).cwiseMax(1e-6);
+    // About two points per cell.
+    cell_ = std::cbrt(ext.prod() / std::max<double>(1.0, 0.5 * static_cast<double>(pts.size())));
+    cell_ = std::max({cell_, ext.maxCoeff() / 256.0, 1e-6});
+    origin_ = lo;
+    for (int a = 0; a < 3; ++a) dims_[a] = std::max(1, static_cast<int>(std::floor(ext[a] / cell_)) + 1);
+    const size_t cells = static_cast<size_t>(dims_[0]) * dims_[1] * dims_[2];
+    start_.assign(cells + 1, 0);
+    for (int p : pts) ++start_[cellOf(x.row(p).transpose()) + 1];
+    for (size_t i = 0; i < cells; ++i) start_[i + 1] += start_[i];
+    items_.resize(pts.size());
+    std::vector<int> fill(start_.begin(), start_.end() - 1);
+    for (size_t i = 0; i < pts.size(); ++i) items_[fill[cellOf(x.row(pts[i]).transpose())]++] = static_cast<int>(i);
+  }
+  // The point (an entry of pts) nearest to q, or -1 for an empty set.
+  int nearest(const Eigen::Vector3d& q) const {
+    const std::vector<int>& pts = *pts_;
+    if (pts.empty()) return -1;
+    Eigen::Vector3i c;
+    for (int a = 0; a < 3; ++a) c[a] = clampIndex(q, a);
+    double best = std::numeric_limits<double>::infinity();
+    int best_i = -1;
+    const int max_r = std::max({dims_[0], dims_[1], dims_[2]});
+    for (int r = 0; r <= max_r; ++r) {
+      // Cells at Chebyshev distance r from c.
+      for (int i = c[0] - r; i <= c[0] + r; ++i) {
+        if (i < 0 || i >= dims_[0]) continue;
+        for (int j = c[1] - r; j <= c[1] + r; ++j) {
+          if (j < 0 || j >= dims_[1]) continue;
+          const bool edge_ij = std::abs(i - c[0]) == r || std::abs(j - c[1]) == r;
+          for (int k = c[2] - r; k <= c[2] + r; k += (edge_ij || r == 0) ? 1 : 2 * r) {
+            if (k < 0 || k >= dims_[2]) continue;
+            const size_t cell = (static_cast<size_t>(i) * dims_[1] + j) * dims_[2] + k;
+            for (int e = start_[cell]; e < start_[cell + 1]; ++e) {
+              const int idx = items_[e];
+              const double d = (x_->row(pts[idx]).transpose() - q).squaredNorm();
+              if (d < best || (d == best && idx < best_i)) {
+                best = d;
+                best_i = idx;
+              }
+            }
+          }
+        }
+      }
+      // Points in cells further out lie at least r cells away (also when q is outside the
+      // grid and its cell was clamped); stop once the best is clearly nearer than that.
+      const double reach = static_cast<double>(r) * cell_;
+      if (best_i >= 0 && best < reach * reach * (1.0 - 1e-9)) break;
+    }
+    return pts[best_i];
+  }
+
+ private:
+  int clampIndex(const Eigen::Vector3d& q, int a) const {
+    const double f = std::floor((q[a] - origin_[a]) / cell_);
+    return static_cast<int>(std::clamp(f, 0.0, static_cast<double>(dims_[a] - 1)));
+  }
+  size_t cellOf(const Eigen::Vector3d& q) const {
+    return (static_cast<size_t>(clampIndex(q, 0)) * dims_[1] + clampIndex(q, 1)) * dims_[2] + clampIndex(q, 2);
+  }
+  const std::vector<int>* pts_ = nullptr;
+  const sim::NodeVectors* x_ = nullptr;
+  Eigen::Vector3d origin_{0, 0, 0};
+  double cell_ = 1.0;
+  Eigen::Vector3i dims_{1, 1, 1};
+  std::vector<int> start_, items_;
+};
+
 // The free pieces of a cut mesh as chips: surface (current positions), material for
 // drawing, volume, mass, centre of mass and mean velocity. `after` holds the current
 // positions; v (#N x 3) the velocities; on_cut (#N) marks nodes on a cut surface.
 std::vector<ChipShape> chipShapes(const cutting::TetMesh& after, const sim::NodeVectors& v,
-                                  const cutting::Components3D& comps, const std::vector<std::uint8_t>& on_cut,
+                                  const Pieces& comps, const std::vector<std::uint8_t>& on_cut,
                                   const std::vector<sim::Material>& materials, int myoma_label) {
   std::vector<std::vector<int>> tets(static_cast<size_t>(comps.count));
   for (int t = 0; t < after.numTets(); ++t) {
@@ -202,12 +367,27 @@ void Simulation::resetState(const sim::NodeVectors* x, const sim::NodeVectors* v
   }
 }
 
-Status Simulation::rebuildGeometry(PassRecord* timing) {
+Status Simulation::rebuildGeometry(PassRecord* timing, const std::vector<std::uint8_t>* boundary) {
   PassTimer timer;
 
   // Surface for contact and rendering: boundary faces, compacted vertex numbering.
   Eigen::VectorXi face_tet;
-  surface_faces_ = cutting::boundaryFaces(mesh_, &face_tet);
+  if (boundary != nullptr && boundary->size() == 4 * static_cast<size_t>(mesh_.numTets())) {
+    const auto count = static_cast<Eigen::Index>(std::count(boundary->begin(), boundary->end(), 1));
+    surface_faces_.resize(count, 3);
+    face_tet.resize(count);
+    Eigen::Index row = 0;
+    for (size_t slot = 0; slot < boundary->size(); ++slot) {
+      if (!(*boundary)[slot]) continue;
+      const int t = static_cast<int>(slot / 4);
+      const int* local = kTetFace[slot % 4];
+      surface_faces_.row(row) << mesh_.T(t, local[0]), mesh_.T(t, local[1]), mesh_.T(t, local[2]);
+      face_tet(row) = t;
+      ++row;
+    }
+  } else {
+    surface_faces_ = cutting::boundaryFaces(mesh_, &face_tet);
+  }
   surface_nodes_.clear();
   surface_triangles_.clear();
   surface_material_.clear();
@@ -513,21 +693,19 @@ void Simulation::finishPass() {
   for (int t = 0; t < mesh_.numTets(); ++t)
     for (int k = 0; k < 4; ++k) node_tet[mesh_.T(t, k)] = t;
   const int kept = static_cast<int>(kept_rows.size());
+  NearestPoint nearest_surface;  // built at the first point outside the tissue
+  bool nearest_built = false;
   cutting::Positions rv(static_cast<Eigen::Index>(kept) * row_size, 3);
   for (int r = 0; r < kept; ++r)
     for (int i = 0; i < row_size; ++i) {
       const Eigen::Vector3d p = sv.row(kept_rows[r] * row_size + i).transpose();
       int t = locator_.locate(mesh_, state_.x, p);
       if (t < 0) {
-        int nearest = -1;
-        double best = std::numeric_limits<double>::infinity();
-        for (int node : surface_nodes_) {
-          const double d = (state_.x.row(node).transpose() - p).squaredNorm();
-          if (d < best) {
-            best = d;
-            nearest = node;
-          }
+        if (!nearest_built) {
+          nearest_surface.build(state_.x, surface_nodes_);
+          nearest_built = true;
         }
+        const int nearest = nearest_surface.nearest(p);
         if (nearest < 0) return fail("no tissue to map the sweep to");
         t = node_tet[nearest];
       }
@@ -599,10 +777,20 @@ void Simulation::finishPass() {
   for (int j : change.moved_nodes) reanchor(j);
   for (int j : change.cut_nodes) reanchor(j);
   // Chips: pieces connected to no anchored node are removed (their volume is resected).
-  std::vector<int> anchored;
-  for (int i = 0; i < n; ++i)
-    if (anchored_after[i]) anchored.push_back(i);
-  const cutting::Components3D comps = cutting::tetComponents(after, anchored);
+  std::vector<int> face_next;
+  Pieces comps;
+  if (matchFaces(after, face_next)) {
+    comps = tetPieces(after, face_next, anchored_after);
+  } else {  // not reached for a valid mesh
+    std::vector<int> anchored;
+    for (int i = 0; i < n; ++i)
+      if (anchored_after[i]) anchored.push_back(i);
+    const cutting::Components3D c = cutting::tetComponents(after, anchored);
+    comps.count = c.count;
+    comps.label.assign(c.label.data(), c.label.data() + c.label.size());
+    comps.free.assign(c.free.begin(), c.free.end());
+    face_next.clear();
+  }
   int myoma_label = -1;
   for (const sim::Material& m : scene_.materials) {
     if (m.name == "myoma") myoma_label = m.label;
@@ -643,6 +831,14 @@ void Simulation::finishPass() {
   for (size_t k = 0; k < keep_tets.size(); ++k) {
     for (int c = 0; c < 4; ++c) rest_mesh.T(static_cast<Eigen::Index>(k), c) = new_index[after.T(keep_tets[k], c)];
     rest_mesh.material[static_cast<Eigen::Index>(k)] = after.material[keep_tets[k]];
+  }
+  // Its boundary: the kept tets' faces that no other tet shares (a kept tet's neighbours
+  // are in its component, so kept too), in the order cutting::boundaryFaces gives.
+  std::vector<std::uint8_t> kept_boundary;
+  if (!face_next.empty()) {
+    kept_boundary.resize(4 * keep_tets.size());
+    for (size_t k = 0; k < keep_tets.size(); ++k)
+      for (int f = 0; f < 4; ++f) kept_boundary[4 * k + f] = face_next[4 * static_cast<size_t>(keep_tets[k]) + f] < 0;
   }
   // Nodes on a cut surface, this pass's and earlier ones', in the new numbering.
   std::vector<std::uint8_t> on_cut(n, 0);
@@ -686,7 +882,9 @@ void Simulation::finishPass() {
   rec.stability_nodes = update.stability_nodes;
   rec.global_stability = update.global_stability;
   timer.lap(&rec.model_ms);
-  if (Status st = rebuildGeometry(&rec); !st.ok()) return fail(st.error());
+  if (Status st = rebuildGeometry(&rec, kept_boundary.empty() ? nullptr : &kept_boundary); !st.ok()) {
+    return fail(st.error());
+  }
   timer.lap(nullptr);
   for (const ChipShape& chip : chip_shapes) chips_->addChip(chip);  // after the cavity is rebuilt
   timer.lap(&rec.chips_ms);
