@@ -38,36 +38,44 @@ constexpr int kTetFace[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
 bool matchFaces(const cutting::TetMesh& mesh, std::vector<int>& next) {
   const int M = mesh.numTets(), N = mesh.numNodes();
   const size_t S = 4 * static_cast<size_t>(M);
-  std::vector<std::array<int, 3>> key(S);
-  std::vector<int> start(static_cast<size_t>(N) + 1, 0);
+  struct Entry {
+    int b, c, slot;  // the face's two larger nodes, and its slot
+  };
+  std::vector<int> start(static_cast<size_t>(N) + 2, 0);
+  for (int k = 0; k < 4; ++k)
+    for (int t = 0; t < M; ++t) {
+      const int a = mesh.T(t, kTetFace[k][0]), b = mesh.T(t, kTetFace[k][1]), c = mesh.T(t, kTetFace[k][2]);
+      if (std::min({a, b, c}) < 0 || std::max({a, b, c}) >= N) return false;
+      ++start[static_cast<size_t>(std::min({a, b, c})) + 2];
+    }
+  for (int i = 0; i < N; ++i) start[i + 2] += start[i + 1];
+  // start[a + 1] is the fill position of bucket a; after filling, start[a]..start[a + 1].
+  std::vector<Entry> entries(S);
   for (int t = 0; t < M; ++t)
     for (int k = 0; k < 4; ++k) {
       int a = mesh.T(t, kTetFace[k][0]), b = mesh.T(t, kTetFace[k][1]), c = mesh.T(t, kTetFace[k][2]);
       if (a > b) std::swap(a, b);
       if (b > c) std::swap(b, c);
       if (a > b) std::swap(a, b);
-      if (a < 0 || c >= N) return false;
-      key[4 * static_cast<size_t>(t) + k] = {a, b, c};
-      ++start[static_cast<size_t>(a) + 1];
+      entries[start[a + 1]++] = {b, c, 4 * t + k};
     }
-  for (int i = 0; i < N; ++i) start[i + 1] += start[i];
-  std::vector<int> order(S), fill(start.begin(), start.end() - 1);
-  for (size_t s = 0; s < S; ++s) order[fill[key[s][0]]++] = static_cast<int>(s);
   next.assign(S, -1);
   for (int n = 0; n < N; ++n) {
-    int* const first = order.data() + start[n];
-    int* const last = order.data() + start[n + 1];
-    std::sort(first, last, [&](int x, int y) {
-      if (key[x][1] != key[y][1]) return key[x][1] < key[y][1];
-      if (key[x][2] != key[y][2]) return key[x][2] < key[y][2];
-      return x < y;
-    });
-    for (int* i = first; i < last;) {
-      int* j = i + 1;
-      while (j < last && key[*j][1] == key[*i][1] && key[*j][2] == key[*i][2]) ++j;
+    Entry* const first = entries.data() + start[n];
+    Entry* const last = entries.data() + start[n + 1];
+    // Insertion sort by (b, c): a bucket holds a few dozen faces.
+    for (Entry* i = first + 1; i < last; ++i) {
+      const Entry e = *i;
+      Entry* j = i;
+      for (; j > first && (j[-1].b > e.b || (j[-1].b == e.b && j[-1].c > e.c)); --j) *j = j[-1];
+      *j = e;
+    }
+    for (Entry* i = first; i < last;) {
+      Entry* j = i + 1;
+      while (j < last && j->b == i->b && j->c == i->c) ++j;
       if (j - i > 1) {
-        for (int* q = i; q + 1 < j; ++q) next[*q] = *(q + 1);
-        next[*(j - 1)] = *i;
+        for (Entry* q = i; q + 1 < j; ++q) next[q->slot] = (q + 1)->slot;
+        next[(j - 1)->slot] = i->slot;
       }
       i = j;
     }
