@@ -76,6 +76,14 @@ int TetLocator::locate(const cutting::TetMesh& mesh, const sim::NodeVectors& x, 
     const Eigen::Vector3d a = x.row(mesh.T(t, 0)).transpose();
     Eigen::Matrix3d m;
     for (int k = 0; k < 3; ++k) m.col(k) = x.row(mesh.T(t, k + 1)).transpose() - a;
+    // A cell lists every tet whose box, grown by the margin, meets it (~170 in the uterus
+    // mesh): most are rejected by their box before the barycentric test. The box is grown by
+    // a millionth of its size, far more than the test's rounding (which would need a tet with
+    // a condition number ~1e9 to accept a point that much outside it).
+    const Eigen::Array3d lo = m.rowwise().minCoeff().array().min(0.0) + a.array();
+    const Eigen::Array3d hi = m.rowwise().maxCoeff().array().max(0.0) + a.array();
+    const double tol = 1e-6 * (hi - lo).maxCoeff();
+    if ((p.array() < lo - tol).any() || (p.array() > hi + tol).any()) continue;
     const double det = m.determinant();
     if (std::abs(det) < 1e-300) continue;
     const Eigen::Vector3d w = m.inverse() * (p - a);  // barycentric coordinates of nodes 1..3
