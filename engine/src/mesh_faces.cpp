@@ -35,7 +35,8 @@ bool matchFaces(const cutting::TetMesh& mesh, std::vector<int>& next) {
   for (int n = 0; n < N; ++n) {
     Entry* const first = entries.data() + start[n];
     Entry* const last = entries.data() + start[n + 1];
-    // Insertion sort by (b, c): a bucket holds a few dozen faces.
+    // Insertion sort by (b, c), a bucket holds a few dozen faces; stable, so equal faces stay
+    // in ascending slot order (the order they were filled in).
     for (Entry* i = first + 1; i < last; ++i) {
       const Entry e = *i;
       Entry* j = i;
@@ -63,8 +64,9 @@ Pieces tetPieces(const cutting::TetMesh& mesh, const std::vector<int>& next, con
     while (parent[x] != x) x = parent[x] = parent[parent[x]];
     return x;
   };
+  // Each cycle ascends through its slots and wraps once: its ascending links join it all.
   for (size_t s = 0; s < next.size(); ++s)
-    if (next[s] >= 0) parent[find(static_cast<int>(s / 4))] = find(next[s] / 4);
+    if (next[s] > static_cast<int>(s)) parent[find(static_cast<int>(s / 4))] = find(next[s] / 4);
   Pieces c;
   c.label.assign(static_cast<size_t>(M), -1);
   std::vector<int> id(static_cast<size_t>(M), -1);

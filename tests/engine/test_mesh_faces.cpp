@@ -68,6 +68,23 @@ TEST(MeshFaces, SameAsCuttingOnTheUterus) {
   expectSameAsCutting(*mesh);
 }
 
+TEST(MeshFaces, AFaceSharedByThreeTetsJoinsThemAll) {
+  // Not a valid mesh, but cutting::tetComponents joins all the tets of a face: so must this.
+  cutting::TetMesh m;
+  m.X.resize(7, 3);
+  m.X << 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0.2, 0.2, 1, 0.1, 0.3, -1, 5, 5, 5;
+  m.T.resize(4, 4);
+  m.T << 6, 3, 4, 5, 0, 1, 2, 3, 3, 4, 5, 6, 0, 2, 1, 5;
+  m.T.row(0) << 6, 4, 5, 3;
+  m.T.row(2) << 1, 2, 0, 4;  // (0, 1, 2) in tets 1, 2 and 3; tet 0 apart
+  m.material = cutting::Labels::Ones(4);
+  expectSameAsCutting(m);
+  std::vector<int> next;
+  ASSERT_TRUE(matchFaces(m, next));
+  const Pieces p = tetPieces(m, next, std::vector<std::uint8_t>(7, 0));
+  EXPECT_EQ(p.count, 2);
+}
+
 TEST(MeshFaces, RejectsMissingNodes) {
   auto box = testing::boxTetMesh(2, 2, 2, 0.5);
   box.T(0, 0) = box.numNodes();

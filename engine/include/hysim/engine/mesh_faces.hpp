@@ -17,7 +17,8 @@ namespace hysim::engine {
 inline constexpr int kTetFace[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
 
 // Slot s = 4 t + k is face k of tet t; next[s] (4 #T) is another slot with the same three
-// nodes (the slots of a shared face form a cycle), or -1 where the face is on the boundary.
+// nodes (the slots of a shared face form a cycle, in ascending slot order), or -1 where the
+// face is on the boundary.
 // Faces are bucketed by their smallest node (a counting sort), then sorted by the other two
 // inside each bucket (a few dozen faces). Returns false (next untouched) for node ids
 // outside [0, #N), which a valid mesh never has.
@@ -25,7 +26,7 @@ bool matchFaces(const cutting::TetMesh& mesh, std::vector<int>& next);
 
 // Connected components through shared faces, numbered in the order of their first tet, and
 // whether each touches no anchored node: cutting::tetComponents' label, count and free (not
-// its volumes), from a face matching.
+// its volumes), from matchFaces' next.
 struct Pieces {
   std::vector<int> label;  // #T
   int count = 0;
