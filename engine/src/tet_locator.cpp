@@ -43,8 +43,11 @@ void TetLocator::build(const cutting::TetMesh& mesh, const sim::NodeVectors& x, 
     }
   };
   auto index = [&](int i, int j, int k) { return (static_cast<long>(k) * dims_.y() + j) * dims_.x() + i; };
-  Eigen::Vector3i a, b;
+  // Each tet's cell range, kept for the second pass.
+  ranges_.resize(2 * static_cast<size_t>(nt));
   for (int t = 0; t < nt; ++t) {
+    Eigen::Vector3i& a = ranges_[2 * static_cast<size_t>(t)];
+    Eigen::Vector3i& b = ranges_[2 * static_cast<size_t>(t) + 1];
     cellRange(t, a, b);
     for (int k = a.z(); k <= b.z(); ++k)
       for (int j = a.y(); j <= b.y(); ++j)
@@ -55,7 +58,8 @@ void TetLocator::build(const cutting::TetMesh& mesh, const sim::NodeVectors& x, 
   std::vector<int>& fill = fill_;
   fill.assign(cell_start_.begin(), cell_start_.end() - 1);
   for (int t = 0; t < nt; ++t) {
-    cellRange(t, a, b);
+    const Eigen::Vector3i& a = ranges_[2 * static_cast<size_t>(t)];
+    const Eigen::Vector3i& b = ranges_[2 * static_cast<size_t>(t) + 1];
     for (int k = a.z(); k <= b.z(); ++k)
       for (int j = a.y(); j <= b.y(); ++j)
         for (int i = a.x(); i <= b.x(); ++i) cell_tets_[fill[index(i, j, k)]++] = t;

@@ -30,6 +30,7 @@ class TetLocator {
   std::vector<int> cell_start_;  // #cells + 1
   std::vector<int> cell_tets_;
   std::vector<int> fill_;        // build scratch
+  std::vector<Eigen::Vector3i> ranges_;  // build scratch: first and last cell of each tet
   sim::NodeVectors built_x_;
   double margin_ = 1.0;
 };
