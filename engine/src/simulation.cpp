@@ -505,7 +505,11 @@ void Simulation::finishPass() {
     const double moved = (sv.row(r * row_size + row_size / 2) - sv.row(last * row_size + row_size / 2)).norm();
     if (moved >= 0.3 || r == rows - 1) kept_rows.push_back(r);
   }
-  if (locator_.maxDisplacement(state_.x) > locator_.margin()) locator_.build(mesh_, state_.x);
+  double displacement = locator_.maxDisplacement(state_.x);  // since the locator's build
+  if (displacement > locator_.margin()) {
+    locator_.build(mesh_, state_.x);
+    displacement = 0.0;
+  }
   // Barycentric coordinates of p in tet t at positions x (may lie outside [0, 1]).
   auto barycentric = [&](int t, const Eigen::Vector3d& p) {
     const Eigen::Vector3d a = state_.x.row(mesh_.T(t, 0)).transpose();
@@ -524,7 +528,7 @@ void Simulation::finishPass() {
   for (int r = 0; r < kept; ++r)
     for (int i = 0; i < row_size; ++i) {
       const Eigen::Vector3d p = sv.row(kept_rows[r] * row_size + i).transpose();
-      int t = locator_.locate(mesh_, state_.x, p);
+      int t = locator_.locate(mesh_, state_.x, p, displacement);
       if (t < 0) {
         if (!nearest_built) {
           nearest_surface.build(state_.x, surface_nodes_);

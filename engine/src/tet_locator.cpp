@@ -37,6 +37,11 @@ void TetLocator::build(const cutting::TetMesh& mesh, const sim::NodeVectors& x, 
       tlo = tlo.cwiseMin(x.row(mesh.T(t, k)).transpose());
       thi = thi.cwiseMax(x.row(mesh.T(t, k)).transpose());
     }
+    double* box = &boxes_[6 * static_cast<size_t>(t)];
+    for (int c = 0; c < 3; ++c) {
+      box[c] = tlo[c];
+      box[3 + c] = thi[c];
+    }
     for (int c = 0; c < 3; ++c) {
       a[c] = std::clamp(static_cast<int>(std::floor((tlo[c] - margin_ - origin_[c]) / cell_)), 0, dims_[c] - 1);
       b[c] = std::clamp(static_cast<int>(std::floor((thi[c] + margin_ - origin_[c]) / cell_)), 0, dims_[c] - 1);
@@ -45,6 +50,7 @@ void TetLocator::build(const cutting::TetMesh& mesh, const sim::NodeVectors& x, 
   auto index = [&](int i, int j, int k) { return (static_cast<long>(k) * dims_.y() + j) * dims_.x() + i; };
   // Each tet's cell range, kept for the second pass.
   ranges_.resize(2 * static_cast<size_t>(nt));
+  boxes_.resize(6 * static_cast<size_t>(nt));
   for (int t = 0; t < nt; ++t) {
     Eigen::Vector3i& a = ranges_[2 * static_cast<size_t>(t)];
     Eigen::Vector3i& b = ranges_[2 * static_cast<size_t>(t) + 1];
@@ -66,8 +72,10 @@ void TetLocator::build(const cutting::TetMesh& mesh, const sim::NodeVectors& x, 
   }
 }
 
-int TetLocator::locate(const cutting::TetMesh& mesh, const sim::NodeVectors& x, const Eigen::Vector3d& p) const {
+int TetLocator::locate(const cutting::TetMesh& mesh, const sim::NodeVectors& x, const Eigen::Vector3d& p,
+                       double max_displacement) const {
   if (cell_start_.empty()) return -1;
+  const double moved = max_displacement >= 0.0 ? max_displacement : margin_;
   int ijk[3];
   for (int c = 0; c < 3; ++c) {
     const int v = static_cast<int>(std::floor((p[c] - origin_[c]) / cell_));
@@ -77,6 +85,16 @@ int TetLocator::locate(const cutting::TetMesh& mesh, const sim::NodeVectors& x, 
   const long cell = (static_cast<long>(ijk[2]) * dims_.y() + ijk[1]) * dims_.x() + ijk[0];
   for (int e = cell_start_[cell]; e < cell_start_[cell + 1]; ++e) {
     const int t = cell_tets_[e];
+    // The box at the build, grown by how far the nodes may have moved since and the test's
+    // tolerance below (for the largest box the tet can have now), holds the box below: a
+    // point outside it fails that test too, without reading the tet's nodes.
+    const double* box = &boxes_[6 * static_cast<size_t>(t)];
+    const double built = std::max({box[3] - box[0], box[4] - box[1], box[5] - box[2]});
+    const double grow = moved + 1e-6 * (built + 2.0 * moved) + 1e-9;
+    if (p[0] < box[0] - grow || p[1] < box[1] - grow || p[2] < box[2] - grow || p[0] > box[3] + grow ||
+        p[1] > box[4] + grow || p[2] > box[5] + grow) {
+      continue;
+    }
     const Eigen::Vector3d a = x.row(mesh.T(t, 0)).transpose();
     Eigen::Matrix3d m;
     for (int k = 0; k < 3; ++k) m.col(k) = x.row(mesh.T(t, k + 1)).transpose() - a;
