@@ -10,6 +10,7 @@
 #include <limits>
 
 #include "hysim/cutting/cut3d.hpp"
+#include "hysim/engine/mesh_faces.hpp"
 #include "hysim/cutting/mesh_io.hpp"
 #include "hysim/cutting/mesh_stats.hpp"
 #include "hysim/sim/tissue_update3d.hpp"
@@ -29,7 +30,7 @@ Eigen::Vector3d closestOnSegment(const Eigen::Vector3d& p, const Eigen::Vector3d
 // drawing, volume, mass, centre of mass and mean velocity. `after` holds the current
 // positions; v (#N x 3) the velocities; on_cut (#N) marks nodes on a cut surface.
 std::vector<ChipShape> chipShapes(const cutting::TetMesh& after, const sim::NodeVectors& v,
-                                  const cutting::Components3D& comps, const std::vector<std::uint8_t>& on_cut,
+                                  const Pieces& comps, const std::vector<std::uint8_t>& on_cut,
                                   const std::vector<sim::Material>& materials, int myoma_label) {
   std::vector<std::vector<int>> tets(static_cast<size_t>(comps.count));
   for (int t = 0; t < after.numTets(); ++t) {
@@ -202,12 +203,16 @@ void Simulation::resetState(const sim::NodeVectors* x, const sim::NodeVectors* v
   }
 }
 
-Status Simulation::rebuildGeometry(PassRecord* timing) {
+Status Simulation::rebuildGeometry(PassRecord* timing, const std::vector<std::uint8_t>* boundary) {
   PassTimer timer;
 
   // Surface for contact and rendering: boundary faces, compacted vertex numbering.
   Eigen::VectorXi face_tet;
-  surface_faces_ = cutting::boundaryFaces(mesh_, &face_tet);
+  if (boundary != nullptr && boundary->size() == 4 * static_cast<size_t>(mesh_.numTets())) {
+    boundaryFromSlots(mesh_, *boundary, surface_faces_, face_tet);
+  } else {
+    surface_faces_ = cutting::boundaryFaces(mesh_, &face_tet);
+  }
   surface_nodes_.clear();
   surface_triangles_.clear();
   surface_material_.clear();
@@ -500,7 +505,11 @@ void Simulation::finishPass() {
     const double moved = (sv.row(r * row_size + row_size / 2) - sv.row(last * row_size + row_size / 2)).norm();
     if (moved >= 0.3 || r == rows - 1) kept_rows.push_back(r);
   }
-  if (locator_.maxDisplacement(state_.x) > locator_.margin()) locator_.build(mesh_, state_.x);
+  double displacement = locator_.maxDisplacement(state_.x);  // since the locator's build
+  if (displacement > locator_.margin()) {
+    locator_.build(mesh_, state_.x);
+    displacement = 0.0;
+  }
   // Barycentric coordinates of p in tet t at positions x (may lie outside [0, 1]).
   auto barycentric = [&](int t, const Eigen::Vector3d& p) {
     const Eigen::Vector3d a = state_.x.row(mesh_.T(t, 0)).transpose();
@@ -513,21 +522,19 @@ void Simulation::finishPass() {
   for (int t = 0; t < mesh_.numTets(); ++t)
     for (int k = 0; k < 4; ++k) node_tet[mesh_.T(t, k)] = t;
   const int kept = static_cast<int>(kept_rows.size());
+  NearestPoint nearest_surface;  // built at the first point outside the tissue
+  bool nearest_built = false;
   cutting::Positions rv(static_cast<Eigen::Index>(kept) * row_size, 3);
   for (int r = 0; r < kept; ++r)
     for (int i = 0; i < row_size; ++i) {
       const Eigen::Vector3d p = sv.row(kept_rows[r] * row_size + i).transpose();
-      int t = locator_.locate(mesh_, state_.x, p);
+      int t = locator_.locate(mesh_, state_.x, p, displacement);
       if (t < 0) {
-        int nearest = -1;
-        double best = std::numeric_limits<double>::infinity();
-        for (int node : surface_nodes_) {
-          const double d = (state_.x.row(node).transpose() - p).squaredNorm();
-          if (d < best) {
-            best = d;
-            nearest = node;
-          }
+        if (!nearest_built) {
+          nearest_surface.build(state_.x, surface_nodes_);
+          nearest_built = true;
         }
+        const int nearest = nearest_surface.nearest(p);
         if (nearest < 0) return fail("no tissue to map the sweep to");
         t = node_tet[nearest];
       }
@@ -599,10 +606,20 @@ void Simulation::finishPass() {
   for (int j : change.moved_nodes) reanchor(j);
   for (int j : change.cut_nodes) reanchor(j);
   // Chips: pieces connected to no anchored node are removed (their volume is resected).
-  std::vector<int> anchored;
-  for (int i = 0; i < n; ++i)
-    if (anchored_after[i]) anchored.push_back(i);
-  const cutting::Components3D comps = cutting::tetComponents(after, anchored);
+  std::vector<int> face_next;
+  Pieces comps;
+  if (matchFaces(after, face_next)) {
+    comps = tetPieces(after, face_next, anchored_after);
+  } else {  // not reached for a valid mesh
+    std::vector<int> anchored;
+    for (int i = 0; i < n; ++i)
+      if (anchored_after[i]) anchored.push_back(i);
+    const cutting::Components3D c = cutting::tetComponents(after, anchored);
+    comps.count = c.count;
+    comps.label.assign(c.label.data(), c.label.data() + c.label.size());
+    comps.free.assign(c.free.begin(), c.free.end());
+    face_next.clear();
+  }
   int myoma_label = -1;
   for (const sim::Material& m : scene_.materials) {
     if (m.name == "myoma") myoma_label = m.label;
@@ -643,6 +660,14 @@ void Simulation::finishPass() {
   for (size_t k = 0; k < keep_tets.size(); ++k) {
     for (int c = 0; c < 4; ++c) rest_mesh.T(static_cast<Eigen::Index>(k), c) = new_index[after.T(keep_tets[k], c)];
     rest_mesh.material[static_cast<Eigen::Index>(k)] = after.material[keep_tets[k]];
+  }
+  // Its boundary: the kept tets' faces that no other tet shares (a kept tet's neighbours
+  // are in its component, so kept too), in the order cutting::boundaryFaces gives.
+  std::vector<std::uint8_t> kept_boundary;
+  if (!face_next.empty()) {
+    kept_boundary.resize(4 * keep_tets.size());
+    for (size_t k = 0; k < keep_tets.size(); ++k)
+      for (int f = 0; f < 4; ++f) kept_boundary[4 * k + f] = face_next[4 * static_cast<size_t>(keep_tets[k]) + f] < 0;
   }
   // Nodes on a cut surface, this pass's and earlier ones', in the new numbering.
   std::vector<std::uint8_t> on_cut(n, 0);
@@ -686,7 +711,9 @@ void Simulation::finishPass() {
   rec.stability_nodes = update.stability_nodes;
   rec.global_stability = update.global_stability;
   timer.lap(&rec.model_ms);
-  if (Status st = rebuildGeometry(&rec); !st.ok()) return fail(st.error());
+  if (Status st = rebuildGeometry(&rec, kept_boundary.empty() ? nullptr : &kept_boundary); !st.ok()) {
+    return fail(st.error());
+  }
   timer.lap(nullptr);
   for (const ChipShape& chip : chip_shapes) chips_->addChip(chip);  // after the cavity is rebuilt
   timer.lap(&rec.chips_ms);

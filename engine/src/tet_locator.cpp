@@ -37,14 +37,23 @@ void TetLocator::build(const cutting::TetMesh& mesh, const sim::NodeVectors& x, 
       tlo = tlo.cwiseMin(x.row(mesh.T(t, k)).transpose());
       thi = thi.cwiseMax(x.row(mesh.T(t, k)).transpose());
     }
+    double* box = &boxes_[6 * static_cast<size_t>(t)];
+    for (int c = 0; c < 3; ++c) {
+      box[c] = tlo[c];
+      box[3 + c] = thi[c];
+    }
     for (int c = 0; c < 3; ++c) {
       a[c] = std::clamp(static_cast<int>(std::floor((tlo[c] - margin_ - origin_[c]) / cell_)), 0, dims_[c] - 1);
       b[c] = std::clamp(static_cast<int>(std::floor((thi[c] + margin_ - origin_[c]) / cell_)), 0, dims_[c] - 1);
     }
   };
   auto index = [&](int i, int j, int k) { return (static_cast<long>(k) * dims_.y() + j) * dims_.x() + i; };
-  Eigen::Vector3i a, b;
+  // Each tet's cell range, kept for the second pass.
+  ranges_.resize(2 * static_cast<size_t>(nt));
+  boxes_.resize(6 * static_cast<size_t>(nt));
   for (int t = 0; t < nt; ++t) {
+    Eigen::Vector3i& a = ranges_[2 * static_cast<size_t>(t)];
+    Eigen::Vector3i& b = ranges_[2 * static_cast<size_t>(t) + 1];
     cellRange(t, a, b);
     for (int k = a.z(); k <= b.z(); ++k)
       for (int j = a.y(); j <= b.y(); ++j)
@@ -55,15 +64,18 @@ void TetLocator::build(const cutting::TetMesh& mesh, const sim::NodeVectors& x, 
   std::vector<int>& fill = fill_;
   fill.assign(cell_start_.begin(), cell_start_.end() - 1);
   for (int t = 0; t < nt; ++t) {
-    cellRange(t, a, b);
+    const Eigen::Vector3i& a = ranges_[2 * static_cast<size_t>(t)];
+    const Eigen::Vector3i& b = ranges_[2 * static_cast<size_t>(t) + 1];
     for (int k = a.z(); k <= b.z(); ++k)
       for (int j = a.y(); j <= b.y(); ++j)
         for (int i = a.x(); i <= b.x(); ++i) cell_tets_[fill[index(i, j, k)]++] = t;
   }
 }
 
-int TetLocator::locate(const cutting::TetMesh& mesh, const sim::NodeVectors& x, const Eigen::Vector3d& p) const {
+int TetLocator::locate(const cutting::TetMesh& mesh, const sim::NodeVectors& x, const Eigen::Vector3d& p,
+                       double max_displacement) const {
   if (cell_start_.empty()) return -1;
+  const double moved = max_displacement >= 0.0 ? max_displacement : margin_;
   int ijk[3];
   for (int c = 0; c < 3; ++c) {
     const int v = static_cast<int>(std::floor((p[c] - origin_[c]) / cell_));
@@ -73,9 +85,27 @@ int TetLocator::locate(const cutting::TetMesh& mesh, const sim::NodeVectors& x, 
   const long cell = (static_cast<long>(ijk[2]) * dims_.y() + ijk[1]) * dims_.x() + ijk[0];
   for (int e = cell_start_[cell]; e < cell_start_[cell + 1]; ++e) {
     const int t = cell_tets_[e];
+    // The box at the build, grown by how far the nodes may have moved since and the test's
+    // tolerance below (for the largest box the tet can have now), holds the box below: a
+    // point outside it fails that test too, without reading the tet's nodes.
+    const double* box = &boxes_[6 * static_cast<size_t>(t)];
+    const double built = std::max({box[3] - box[0], box[4] - box[1], box[5] - box[2]});
+    const double grow = moved + 1e-6 * (built + 2.0 * moved) + 1e-9;
+    if (p[0] < box[0] - grow || p[1] < box[1] - grow || p[2] < box[2] - grow || p[0] > box[3] + grow ||
+        p[1] > box[4] + grow || p[2] > box[5] + grow) {
+      continue;
+    }
     const Eigen::Vector3d a = x.row(mesh.T(t, 0)).transpose();
     Eigen::Matrix3d m;
     for (int k = 0; k < 3; ++k) m.col(k) = x.row(mesh.T(t, k + 1)).transpose() - a;
+    // A cell lists every tet whose box, grown by the margin, meets it (~170 in the uterus
+    // mesh): most are rejected by their box before the barycentric test. The box is grown by
+    // a millionth of its size, far more than the test's rounding (which would need a tet with
+    // a condition number ~1e9 to accept a point that much outside it).
+    const Eigen::Array3d lo = m.rowwise().minCoeff().array().min(0.0) + a.array();
+    const Eigen::Array3d hi = m.rowwise().maxCoeff().array().max(0.0) + a.array();
+    const double tol = 1e-6 * (hi - lo).maxCoeff();
+    if ((p.array() < lo - tol).any() || (p.array() > hi + tol).any()) continue;
     const double det = m.determinant();
     if (std::abs(det) < 1e-300) continue;
     const Eigen::Vector3d w = m.inverse() * (p - a);  // barycentric coordinates of nodes 1..3

@@ -126,7 +126,9 @@ class Simulation {
                      PassRecord* timing = nullptr);
   // Everything built from mesh_ and state_.x for contact, collision and drawing: boundary
   // faces, render surface, contact nodes, FCL hierarchy, tet locator, chips' cavity.
-  Status rebuildGeometry(PassRecord* timing);
+  // `boundary` (optional, 4 #T): which tet faces (slot 4 t + k, face k opposite vertex k) lie
+  // on the boundary, when the caller knows; else they are found from mesh_.
+  Status rebuildGeometry(PassRecord* timing, const std::vector<std::uint8_t>* boundary = nullptr);
   // State for model_ and mesh_ with positions x and velocities v (null: rest, zero), keeping
   // the step count, time and warnings; counts anchored and deformable elements.
   void resetState(const sim::NodeVectors* x, const sim::NodeVectors* v);

@@ -17,8 +17,11 @@ namespace hysim::engine {
 class TetLocator {
  public:
   void build(const cutting::TetMesh& mesh, const sim::NodeVectors& x, double margin_mm = 3.0);
-  // Tet containing p at positions x, or -1. Allocates nothing.
-  int locate(const cutting::TetMesh& mesh, const sim::NodeVectors& x, const Eigen::Vector3d& p) const;
+  // Tet containing p at positions x, or -1. Allocates nothing. max_displacement: a bound on
+  // how far the nodes moved since the build (maxDisplacement(x)), when the caller knows one
+  // (the answer is the same, found faster); else the margin.
+  int locate(const cutting::TetMesh& mesh, const sim::NodeVectors& x, const Eigen::Vector3d& p,
+             double max_displacement = -1.0) const;
   // Largest node displacement since the build (O(#N)); rebuild when it exceeds margin().
   double maxDisplacement(const sim::NodeVectors& x) const;
   double margin() const { return margin_; }
@@ -30,6 +33,8 @@ class TetLocator {
   std::vector<int> cell_start_;  // #cells + 1
   std::vector<int> cell_tets_;
   std::vector<int> fill_;        // build scratch
+  std::vector<Eigen::Vector3i> ranges_;  // build scratch: first and last cell of each tet
+  std::vector<double> boxes_;            // 6 #T: each tet's box at the build (min xyz, max xyz)
   sim::NodeVectors built_x_;
   double margin_ = 1.0;
 };

@@ -1,0 +1,171 @@
+#include "hysim/engine/mesh_faces.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <limits>
+
+namespace hysim::engine {
+
+bool matchFaces(const cutting::TetMesh& mesh, std::vector<int>& next) {
+  const int M = mesh.numTets(), N = mesh.numNodes();
+  const size_t S = 4 * static_cast<size_t>(M);
+  struct Entry {
+    int b, c, slot;  // the face's two larger nodes, and its slot
+  };
+  std::vector<int> start(static_cast<size_t>(N) + 2, 0);
+  for (int k = 0; k < 4; ++k)
+    for (int t = 0; t < M; ++t) {
+      const int a = mesh.T(t, kTetFace[k][0]), b = mesh.T(t, kTetFace[k][1]), c = mesh.T(t, kTetFace[k][2]);
+      if (std::min({a, b, c}) < 0 || std::max({a, b, c}) >= N) return false;
+      ++start[static_cast<size_t>(std::min({a, b, c})) + 2];
+    }
+  for (int i = 0; i < N; ++i) start[i + 2] += start[i + 1];
+  // start[a + 1] is the fill position of bucket a; after filling, start[a]..start[a + 1].
+  std::vector<Entry> entries(S);
+  for (int t = 0; t < M; ++t)
+    for (int k = 0; k < 4; ++k) {
+      int a = mesh.T(t, kTetFace[k][0]), b = mesh.T(t, kTetFace[k][1]), c = mesh.T(t, kTetFace[k][2]);
+      if (a > b) std::swap(a, b);
+      if (b > c) std::swap(b, c);
+      if (a > b) std::swap(a, b);
+      entries[start[a + 1]++] = {b, c, 4 * t + k};
+    }
+  next.assign(S, -1);
+  for (int n = 0; n < N; ++n) {
+    Entry* const first = entries.data() + start[n];
+    Entry* const last = entries.data() + start[n + 1];
+    // Insertion sort by (b, c), a bucket holds a few dozen faces; stable, so equal faces stay
+    // in ascending slot order (the order they were filled in).
+    for (Entry* i = first + 1; i < last; ++i) {
+      const Entry e = *i;
+      Entry* j = i;
+      for (; j > first && (j[-1].b > e.b || (j[-1].b == e.b && j[-1].c > e.c)); --j) *j = j[-1];
+      *j = e;
+    }
+    for (Entry* i = first; i < last;) {
+      Entry* j = i + 1;
+      while (j < last && j->b == i->b && j->c == i->c) ++j;
+      if (j - i > 1) {
+        for (Entry* q = i; q + 1 < j; ++q) next[q->slot] = (q + 1)->slot;
+        next[(j - 1)->slot] = i->slot;
+      }
+      i = j;
+    }
+  }
+  return true;
+}
+
+Pieces tetPieces(const cutting::TetMesh& mesh, const std::vector<int>& next, const std::vector<std::uint8_t>& anchored) {
+  const int M = mesh.numTets();
+  std::vector<int> parent(static_cast<size_t>(M));
+  for (int t = 0; t < M; ++t) parent[t] = t;
+  auto find = [&](int x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+  };
+  // Each cycle ascends through its slots and wraps once: its ascending links join it all.
+  for (size_t s = 0; s < next.size(); ++s)
+    if (next[s] > static_cast<int>(s)) parent[find(static_cast<int>(s / 4))] = find(next[s] / 4);
+  Pieces c;
+  c.label.assign(static_cast<size_t>(M), -1);
+  std::vector<int> id(static_cast<size_t>(M), -1);
+  for (int t = 0; t < M; ++t) {
+    const int r = find(t);
+    if (id[r] < 0) id[r] = c.count++;
+    c.label[t] = id[r];
+  }
+  c.free.assign(static_cast<size_t>(c.count), 1);
+  for (int t = 0; t < M; ++t)
+    for (int k = 0; k < 4; ++k)
+      if (anchored[mesh.T(t, k)]) c.free[c.label[t]] = 0;
+  return c;
+}
+
+void boundaryFromSlots(const cutting::TetMesh& mesh, const std::vector<std::uint8_t>& boundary, cutting::Tris& faces,
+                       Eigen::VectorXi& face_tet) {
+  const auto count = static_cast<Eigen::Index>(std::count(boundary.begin(), boundary.end(), 1));
+  faces.resize(count, 3);
+  face_tet.resize(count);
+  Eigen::Index row = 0;
+  for (size_t slot = 0; slot < boundary.size(); ++slot) {
+    if (!boundary[slot]) continue;
+    const int t = static_cast<int>(slot / 4);
+    const int* local = kTetFace[slot % 4];
+    faces.row(row) << mesh.T(t, local[0]), mesh.T(t, local[1]), mesh.T(t, local[2]);
+    face_tet(row) = t;
+    ++row;
+  }
+}
+
+void NearestPoint::build(const sim::NodeVectors& x, const std::vector<int>& pts) {
+  pts_ = &pts;
+  x_ = &x;
+  if (pts.empty()) return;
+  Eigen::Vector3d lo = x.row(pts[0]).transpose(), hi = lo;
+  for (int p : pts) {
+    lo = lo.cwiseMin(x.row(p).transpose());
+    hi = hi.cwiseMax(x.row(p).transpose());
+  }
+  const Eigen::Vector3d ext = (hi - lo).cwiseMax(1e-6);
+  // About two points per cell.
+  cell_ = std::cbrt(ext.prod() / std::max<double>(1.0, 0.5 * static_cast<double>(pts.size())));
+  cell_ = std::max({cell_, ext.maxCoeff() / 256.0, 1e-6});
+  origin_ = lo;
+  for (int a = 0; a < 3; ++a) dims_[a] = std::max(1, static_cast<int>(std::floor(ext[a] / cell_)) + 1);
+  const size_t cells = static_cast<size_t>(dims_[0]) * dims_[1] * dims_[2];
+  start_.assign(cells + 1, 0);
+  for (int p : pts) ++start_[cellOf(x.row(p).transpose()) + 1];
+  for (size_t i = 0; i < cells; ++i) start_[i + 1] += start_[i];
+  items_.resize(pts.size());
+  std::vector<int> fill(start_.begin(), start_.end() - 1);
+  for (size_t i = 0; i < pts.size(); ++i) items_[fill[cellOf(x.row(pts[i]).transpose())]++] = static_cast<int>(i);
+}
+
+int NearestPoint::nearest(const Eigen::Vector3d& q) const {
+  const std::vector<int>& pts = *pts_;
+  if (pts.empty()) return -1;
+  Eigen::Vector3i c;
+  for (int a = 0; a < 3; ++a) c[a] = clampIndex(q, a);
+  double best = std::numeric_limits<double>::infinity();
+  int best_i = -1;
+  const int max_r = std::max({dims_[0], dims_[1], dims_[2]});
+  for (int r = 0; r <= max_r; ++r) {
+    // Cells at Chebyshev distance r from c.
+    for (int i = c[0] - r; i <= c[0] + r; ++i) {
+      if (i < 0 || i >= dims_[0]) continue;
+      for (int j = c[1] - r; j <= c[1] + r; ++j) {
+        if (j < 0 || j >= dims_[1]) continue;
+        const bool edge_ij = std::abs(i - c[0]) == r || std::abs(j - c[1]) == r;
+        for (int k = c[2] - r; k <= c[2] + r; k += (edge_ij || r == 0) ? 1 : 2 * r) {
+          if (k < 0 || k >= dims_[2]) continue;
+          const size_t cell = (static_cast<size_t>(i) * dims_[1] + j) * dims_[2] + k;
+          for (int e = start_[cell]; e < start_[cell + 1]; ++e) {
+            const int idx = items_[e];
+            const double d = (x_->row(pts[idx]).transpose() - q).squaredNorm();
+            if (d < best || (d == best && idx < best_i)) {
+              best = d;
+              best_i = idx;
+            }
+          }
+        }
+      }
+    }
+    // Points in cells further out lie at least r cells away (also when q is outside the
+    // grid and its cell was clamped); stop once the best is clearly nearer than that.
+    const double reach = static_cast<double>(r) * cell_;
+    if (best_i >= 0 && best < reach * reach * (1.0 - 1e-9)) break;
+  }
+  return pts[best_i];
+}
+
+int NearestPoint::clampIndex(const Eigen::Vector3d& q, int a) const {
+  const double f = std::floor((q[a] - origin_[a]) / cell_);
+  return static_cast<int>(std::clamp(f, 0.0, static_cast<double>(dims_[a] - 1)));
+}
+
+size_t NearestPoint::cellOf(const Eigen::Vector3d& q) const {
+  return (static_cast<size_t>(clampIndex(q, 0)) * dims_[1] + clampIndex(q, 1)) * dims_[2] + clampIndex(q, 2);
+}
+
+}  // namespace hysim::engine
