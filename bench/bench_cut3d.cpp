@@ -4,11 +4,12 @@
 // tets), 1 = tests/data/cutting/uterus_20k.msh (20,971 tets, the same geometry meshed finer,
 // see tests/data/cutting/README.md). Each iteration cuts the same input mesh with one of four
 // fixed planes through the bounding-box centre and updates the mass-spring model and state
-// (sim::updateModel3D: Van Gelder springs, moment-preserving masses; sim::remapState3D).
+// (sim::updateModelAfterCut3D, the simulator's incremental update, or sim::updateModel3D, a
+// whole rebuild; then sim::remapState3D).
 // The benchmark's time is the whole (cut + optimisation + TopologyChange + update); the
 // counters split it: cut_ms (cut3d, incl. optimisation), optimize_ms, update_ms. Medians over
 // the repetitions (the `_median` rows). Run from anywhere:
-//   ./build/bench/bench_cut3d --benchmark_filter=BM_Cut3DUpdate
+//   ./build/bench/bench_cut3d --benchmark_filter='BM_Cut3DUpdate/./././1'   (incremental)
 #include <benchmark/benchmark.h>
 
 #include <chrono>
@@ -83,9 +84,17 @@ void BM_Cut3DUpdate(benchmark::State& state) {
   }
   const Vec3 lo = p.mesh.X.colwise().minCoeff().transpose(), hi = p.mesh.X.colwise().maxCoeff().transpose();
   const auto surface = *hysim::cutting::CutSurface::plane(0.5 * (lo + hi) + kOffsets[plane], kNormals[plane].normalized());
+  const bool incremental = state.range(3) != 0;
   double cutMs = 0, optMs = 0, updMs = 0;
   int elements = 0, nodes = 0;
+  hysim::sim::Model model;
+  std::vector<std::uint8_t> fixed;
   for (auto _ : state) {
+    if (incremental) {  // the update works in place on a copy, made with the timer paused
+      state.PauseTiming();
+      model = p.model;
+      state.ResumeTiming();
+    }
     const auto t0 = std::chrono::steady_clock::now();
     auto r = hysim::cutting::cut3d(p.mesh, surface, o);
     const auto t1 = std::chrono::steady_clock::now();
@@ -93,10 +102,25 @@ void BM_Cut3DUpdate(benchmark::State& state) {
       state.SkipWithError(r.error().c_str());
       return;
     }
-    auto model = hysim::sim::updateModel3D(p.model, p.mesh, r->mesh, r->change);
-    if (!model.ok()) {
-      state.SkipWithError(model.error().c_str());
-      return;
+    if (incremental) {
+      // Anchored after the cut: surviving nodes keep their flag; new nodes are free.
+      fixed.assign(static_cast<size_t>(r->mesh.numNodes()), 0);
+      for (int i = 0; i < p.mesh.numNodes(); ++i) {
+        const int j = r->change.node_old_to_new[i];
+        if (j >= 0) fixed[j] = p.model.fixed[i] ? 1 : 0;
+      }
+      const auto st = hysim::sim::updateModelAfterCut3D(model, p.mesh, r->mesh, r->change, fixed, {});
+      if (!st.ok()) {
+        state.SkipWithError(st.error().c_str());
+        return;
+      }
+    } else {
+      auto rebuilt = hysim::sim::updateModel3D(p.model, p.mesh, r->mesh, r->change);
+      if (!rebuilt.ok()) {
+        state.SkipWithError(rebuilt.error().c_str());
+        return;
+      }
+      model = std::move(*rebuilt);
     }
     auto s = hysim::sim::remapState3D(p.state, r->change);
     const auto t2 = std::chrono::steady_clock::now();
@@ -114,68 +138,17 @@ void BM_Cut3DUpdate(benchmark::State& state) {
   state.counters["update_ms"] = updMs / n;
   state.counters["tets"] = elements;
   state.counters["nodes"] = nodes;
-  state.SetLabel(p.name + " plane " + std::to_string(plane) + " " + hysim::cutting::cutMethodName(o.method));
+  state.SetLabel(p.name + " plane " + std::to_string(plane) + " " + hysim::cutting::cutMethodName(o.method) +
+                 (incremental ? ", incremental update" : ", rebuilt model"));
 }
+// Arguments: mesh, plane, method, update (0: sim::updateModel3D, a whole rebuild through
+// buildModel; 1: sim::updateModelAfterCut3D, what the simulator does after each pass: masses
+// and springs recomputed around the cut only, a Lanczos estimate of the stable substep).
 BENCHMARK(BM_Cut3DUpdate)
-    ->ArgsProduct({{0, 1}, {0, 1, 2, 3}, {static_cast<int>(CutMethod::Hybrid), static_cast<int>(CutMethod::Standard)}})
-    ->Unit(benchmark::kMillisecond)
-    ->MinTime(0.2)
-    ->Repetitions(5)
-    ->ReportAggregatesOnly(true);
-
-// The cut with the incremental update the simulator uses after each pass
-// (sim::updateModelAfterCut3D: masses and springs recomputed around the cut only, a Lanczos
-// estimate of the stable substep; sim::remapState3D). Same counters as BM_Cut3DUpdate. The
-// model is copied before each iteration (the update works in place) with the timer paused.
-void BM_Cut3DIncremental(benchmark::State& state) {
-  const Prepared& p = mesh(static_cast<int>(state.range(0)));
-  const int plane = static_cast<int>(state.range(1));
-  if (!p.ok) {
-    state.SkipWithError("cannot read or model the mesh (assets/uterus_myoma.msh, tests/data/cutting/uterus_20k.msh)");
-    return;
-  }
-  const Vec3 lo = p.mesh.X.colwise().minCoeff().transpose(), hi = p.mesh.X.colwise().maxCoeff().transpose();
-  const auto surface = *hysim::cutting::CutSurface::plane(0.5 * (lo + hi) + kOffsets[plane], kNormals[plane].normalized());
-  double cutMs = 0, optMs = 0, updMs = 0;
-  hysim::sim::Model model;
-  for (auto _ : state) {
-    state.PauseTiming();
-    model = p.model;
-    state.ResumeTiming();
-    const auto t0 = std::chrono::steady_clock::now();
-    auto r = hysim::cutting::cut3d(p.mesh, surface, {});
-    const auto t1 = std::chrono::steady_clock::now();
-    if (!r.ok()) {
-      state.SkipWithError(r.error().c_str());
-      return;
-    }
-    // Anchored after the cut: surviving nodes keep their flag; new nodes (on the cut, inside
-    // the free region here) are free.
-    std::vector<std::uint8_t> fixed(static_cast<size_t>(r->mesh.numNodes()), 0);
-    for (int i = 0; i < p.mesh.numNodes(); ++i) {
-      const int j = r->change.node_old_to_new[i];
-      if (j >= 0) fixed[j] = p.model.fixed[i] ? 1 : 0;
-    }
-    const auto st = hysim::sim::updateModelAfterCut3D(model, p.mesh, r->mesh, r->change, fixed, {});
-    if (!st.ok()) {
-      state.SkipWithError(st.error().c_str());
-      return;
-    }
-    auto s = hysim::sim::remapState3D(p.state, r->change);
-    const auto t2 = std::chrono::steady_clock::now();
-    benchmark::DoNotOptimize(s);
-    cutMs += std::chrono::duration<double, std::milli>(t1 - t0).count();
-    updMs += std::chrono::duration<double, std::milli>(t2 - t1).count();
-    optMs += r->report.optimize_ms;
-  }
-  const double n = static_cast<double>(state.iterations());
-  state.counters["cut_ms"] = cutMs / n;
-  state.counters["optimize_ms"] = optMs / n;
-  state.counters["update_ms"] = updMs / n;
-  state.SetLabel(p.name + " plane " + std::to_string(plane) + " hybrid, incremental update");
-}
-BENCHMARK(BM_Cut3DIncremental)
-    ->ArgsProduct({{0, 1}, {0, 1, 2, 3}})
+    ->ArgsProduct({{0, 1},
+                   {0, 1, 2, 3},
+                   {static_cast<int>(CutMethod::Hybrid), static_cast<int>(CutMethod::Standard)},
+                   {0, 1}})
     ->Unit(benchmark::kMillisecond)
     ->MinTime(0.2)
     ->Repetitions(5)

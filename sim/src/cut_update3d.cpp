@@ -12,15 +12,6 @@
 namespace hysim::sim {
 namespace {
 
-using Row10 = Eigen::Matrix<double, 10, 1>;
-
-Row10 monomials(const Eigen::Vector3d& p) {
-  Row10 r;
-  r << 1.0, p.x(), p.y(), p.z(), p.x() * p.x(), p.y() * p.y(), p.z() * p.z(), p.x() * p.y(), p.y() * p.z(),
-      p.z() * p.x();
-  return r;
-}
-
 // Top eigenvalue of M^-1/2 K M^-1/2 (springs linearised along their rest directions) over
 // the free nodes `nodes`, every other node held fixed (a principal submatrix), by Lanczos.
 // `start` (#N x 3, may be null or zero) is mixed into the deterministic start vector; `mode`

@@ -5,19 +5,9 @@
 #include <cmath>
 #include <string>
 
+#include "model_internal.hpp"
+
 namespace hysim::sim {
-namespace {
-
-using Row10 = Eigen::Matrix<double, 10, 1>;
-
-Row10 monomials(const Eigen::Vector3d& p) {
-  Row10 r;
-  r << 1.0, p.x(), p.y(), p.z(), p.x() * p.x(), p.y() * p.y(), p.z() * p.z(), p.x() * p.y(), p.y() * p.z(),
-      p.z() * p.x();
-  return r;
-}
-
-}  // namespace
 
 Eigen::Matrix<double, 10, 1> massMoments3D(const cutting::Positions& X, const Eigen::VectorXd& mass,
                                            const Eigen::Vector3d& centre, double scale) {
