@@ -299,38 +299,10 @@ Status updateModelAfterCut3D(Model& model, const cutting::TetMesh& before, const
         if (m[j] != 0.0) p += m[j] * monomials((after.X.row(j).transpose() - centre) / scale);
       return p;
     };
-    const Eigen::VectorXd prior = mass;
-    std::vector<std::uint8_t> clamped(static_cast<size_t>(N1), 0);
-    for (int iter = 0; iter < options.masses.max_active_set_iterations; ++iter) {
-      const Row10 r = target - moments(mass);
-      std::vector<int> active;
-      for (int i : unknown)
-        if (!clamped[i]) active.push_back(i);
-      if (active.empty()) break;
-      Eigen::Matrix<double, 10, Eigen::Dynamic> A(10, static_cast<Eigen::Index>(active.size()));
-      for (size_t j = 0; j < active.size(); ++j)
-        A.col(static_cast<Eigen::Index>(j)) = monomials((after.X.row(active[j]).transpose() - centre) / scale);
-      const Eigen::Matrix<double, 10, 10> B = A * A.transpose();
-      const Row10 y = Eigen::CompleteOrthogonalDecomposition<Eigen::Matrix<double, 10, 10>>(B).solve(r);
-      const Eigen::VectorXd dm = A.transpose() * y;
-      bool any = false;
-      for (size_t j = 0; j < active.size(); ++j) {
-        const int i = active[j];
-        const double floor = options.masses.floor_fraction * prior[i];
-        if (mass[i] + dm[static_cast<Eigen::Index>(j)] < floor) {
-          mass[i] = floor;
-          clamped[i] = 1;
-          any = true;
-        }
-      }
-      if (!any) {
-        for (size_t j = 0; j < active.size(); ++j) mass[active[j]] += dm[static_cast<Eigen::Index>(j)];
-        break;
-      }
-    }
+    const int clamped = correctMassMoments(after.X, unknown, target, centre, scale, options.masses, moments, mass);
     const Row10 res = target - moments(mass);
     rep.masses.unknowns = static_cast<int>(unknown.size());
-    for (int i : unknown) rep.masses.clamped += clamped[i];
+    rep.masses.clamped = clamped;
     rep.masses.moment_residual = res.cwiseAbs().maxCoeff() / std::max(target.cwiseAbs().maxCoeff(), 1e-300);
   }
   for (int j : region_nodes)

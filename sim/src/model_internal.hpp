@@ -1,6 +1,11 @@
 #pragma once
 // Pieces of the model build shared by buildModel and the incremental update after a cut.
+#include <functional>
+#include <vector>
+
+#include "hysim/cutting/mesh.hpp"
 #include "hysim/sim/model.hpp"
+#include "hysim/sim/tissue_update3d.hpp"
 
 namespace hysim::sim {
 
@@ -16,5 +21,14 @@ inline Row10 monomials(const Eigen::Vector3d& p) {
       p.z() * p.x();
   return r;
 }
+
+// The smallest correction of the masses of `unknown` (positions X, monomials about `centre`,
+// divided by `scale`) that brings moments(mass) to `target`, no mass below floor_fraction of
+// its value on entry: an active set, clamped masses fixed at their floor and the rest solved
+// again. Returns the number of unknowns clamped. Shared by updateMasses3D (moments of the
+// whole mesh) and updateModelAfterCut3D (moments of the nodes near the cut).
+int correctMassMoments(const cutting::Positions& X, const std::vector<int>& unknown, const Row10& target,
+                       const Eigen::Vector3d& centre, double scale, const MassUpdate3DOptions& options,
+                       const std::function<Row10(const Eigen::VectorXd&)>& moments, Eigen::VectorXd& mass);
 
 }  // namespace hysim::sim

@@ -82,44 +82,53 @@ Result<Eigen::VectorXd> updateMasses3D(const cutting::TetMesh& before, const Eig
     for (int i = 0; i < N1; ++i)
       if (lumped[i] > 0) unknown.push_back(i);
   }
-  const Eigen::VectorXd prior = m;
-  std::vector<std::uint8_t> clamped(N1, 0);
+  auto moments = [&](const Eigen::VectorXd& mass) { return massMoments3D(after.X, mass, centre, scale); };
+  const int clamped = correctMassMoments(after.X, unknown, target, centre, scale, options, moments, m);
+  const Row10 res = target - massMoments3D(after.X, m, centre, scale);
+  rep.unknowns = static_cast<int>(unknown.size());
+  rep.clamped = clamped;
+  rep.moment_residual = res.cwiseAbs().maxCoeff() / std::max(target.cwiseAbs().maxCoeff(), 1e-300);
+  for (int i = 0; i < N1; ++i)
+    if (!(m[i] >= 0) || !std::isfinite(m[i])) return Error{"updateMasses3D: non-finite or negative mass"};
+  if (report) *report = rep;
+  return m;
+}
+
+int correctMassMoments(const cutting::Positions& X, const std::vector<int>& unknown, const Row10& target,
+                       const Eigen::Vector3d& centre, double scale, const MassUpdate3DOptions& options,
+                       const std::function<Row10(const Eigen::VectorXd&)>& moments, Eigen::VectorXd& mass) {
+  const Eigen::VectorXd prior = mass;
+  std::vector<std::uint8_t> clamped(static_cast<size_t>(mass.size()), 0);
   for (int iter = 0; iter < options.max_active_set_iterations; ++iter) {
-    // Residual of the moments with the free unknowns at their prior.
-    Row10 r = target - massMoments3D(after.X, m, centre, scale);
+    const Row10 r = target - moments(mass);
     std::vector<int> active;
     for (int i : unknown)
       if (!clamped[i]) active.push_back(i);
     if (active.empty()) break;
     Eigen::Matrix<double, 10, Eigen::Dynamic> A(10, static_cast<Eigen::Index>(active.size()));
-    for (size_t j = 0; j < active.size(); ++j) A.col(j) = monomials((after.X.row(active[j]).transpose() - centre) / scale);
+    for (size_t j = 0; j < active.size(); ++j)
+      A.col(static_cast<Eigen::Index>(j)) = monomials((X.row(active[j]).transpose() - centre) / scale);
     const Eigen::Matrix<double, 10, 10> B = A * A.transpose();
     const Row10 y = Eigen::CompleteOrthogonalDecomposition<Eigen::Matrix<double, 10, 10>>(B).solve(r);
     const Eigen::VectorXd dm = A.transpose() * y;
     bool any = false;
     for (size_t j = 0; j < active.size(); ++j) {
       const int i = active[j];
-      const double v = m[i] + dm[j];
       const double floor = options.floor_fraction * prior[i];
-      if (v < floor) {
-        m[i] = floor;
+      if (mass[i] + dm[static_cast<Eigen::Index>(j)] < floor) {
+        mass[i] = floor;
         clamped[i] = 1;
         any = true;
       }
     }
     if (!any) {
-      for (size_t j = 0; j < active.size(); ++j) m[active[j]] += dm[j];
+      for (size_t j = 0; j < active.size(); ++j) mass[active[j]] += dm[static_cast<Eigen::Index>(j)];
       break;
     }
   }
-  const Row10 res = target - massMoments3D(after.X, m, centre, scale);
-  rep.unknowns = static_cast<int>(unknown.size());
-  for (int i : unknown) rep.clamped += clamped[i];
-  rep.moment_residual = res.cwiseAbs().maxCoeff() / std::max(target.cwiseAbs().maxCoeff(), 1e-300);
-  for (int i = 0; i < N1; ++i)
-    if (!(m[i] >= 0) || !std::isfinite(m[i])) return Error{"updateMasses3D: non-finite or negative mass"};
-  if (report) *report = rep;
-  return m;
+  int count = 0;
+  for (int i : unknown) count += clamped[i];
+  return count;
 }
 
 State remapState3D(const State& before, const cutting::TopologyChange& change) {
