@@ -13,8 +13,8 @@
 // leaves thin wedges between the cut and the boundary, and rough boundaries from earlier
 // passes), more is allowed, within the volume budget: cut nodes slide on the cut where their
 // cut faces are within boundary_curved_deg; boundary nodes there move on their own boundary
-// faces; rim nodes (cut meets boundary) and crease nodes slide along their ridge; a sliver
-// that cannot be peeled alone goes with its poor face neighbours; 2-3 and 3-2 flips repair
+// faces; rim nodes (cut meets boundary) and crease nodes slide along their ridge (these moves
+// within a small volume budget of their own); 2-3 and 3-2 flips repair
 // slivers whose nodes cannot move; snaps and collapses may change a tiny star's volume by a
 // fraction of a regular tet of the local edge. Plane cuts are as before.
 // Candidate moves (ascent along the gradient of the worst incident element's q*, a damped
@@ -158,10 +158,15 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
                x3 = mesh.X.row(mesh.T(t, 3));
     budget += (x1 - x0).dot((x2 - x0).cross(x3 - x0)) / 6.0;
   }
+  const double meshVolume = budget;
   budget *= options.volume_budget;
   // A collapse or snap may change its star's volume by collapse_volume_fraction of the star,
   // or of a regular tet with the local edge length where the star is smaller (a node very
   // near the cut among tiny tets).
+  const double edgeTet = region.edge_length * region.edge_length * region.edge_length / (6.0 * std::sqrt(2.0));
+  // Moves on curved surfaces: each within move_volume_fraction of a regular tet of the local
+  // edge, all together within move_volume_budget of the mesh's volume.
+  double moveBudget = meshVolume * options.move_volume_budget;
   const double refVolume = curved && options.collapse_volume_fraction_of_edge_tet
                                ? region.edge_length * region.edge_length * region.edge_length / (6.0 * std::sqrt(2.0))
                                : 0.0;
@@ -500,7 +505,6 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       }
     }
   };
-  std::vector<std::int32_t> peelGroup;
   auto peel = [&]() {
     if (!(options.peel_quality > 0)) return;
     std::vector<std::int32_t> candidates;
@@ -518,43 +522,15 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
           liveStar(mesh.T(t, k), around, nullptr);
           ok = discAround(mesh.T(t, k), around);
         }
-        peelGroup.assign({static_cast<std::int32_t>(t)});
-        if (!ok && curved && options.peel_group_quality > 0) {
-          // Together with its poor face neighbours (a sliver in a thin layer left between the
-          // cut and the boundary: alone it would pinch the boundary).
-          for (int f = 0; f < 4; ++f) {
-            const int a = mesh.T(t, kFace[f][0]), b = mesh.T(t, kFace[f][1]), c = mesh.T(t, kFace[f][2]);
-            for (const std::int32_t *s = starB(a), *sEnd = starE(a); s < sEnd; ++s) {
-              const int u = *s;
-              if (u == t || (*dead)[u]) continue;
-              int hits = 0;
-              for (int k = 0; k < 4; ++k) hits += mesh.T(u, k) == b || mesh.T(u, k) == c;
-              if (hits == 2 && tetQ(u) < options.peel_group_quality) peelGroup.push_back(u);
-            }
-          }
-          double vol = 0;
-          for (int u : peelGroup) vol += tetVolume(mesh, u);
-          if (peelGroup.size() > 1 && vol <= budget) {
-            for (int u : peelGroup) kill(u);
-            ok = true;
-            for (size_t i = 0; i < peelGroup.size() && ok; ++i)
-              for (int k = 0; k < 4 && ok; ++k) {
-                liveStar(mesh.T(peelGroup[i], k), around, nullptr);
-                ok = discAround(mesh.T(peelGroup[i], k), around);
-              }
-          }
-        }
         if (!ok) {
-          for (int u : peelGroup) (*dead)[u] = 0;
+          (*dead)[t] = 0;
           continue;
         }
         again = true;
-        for (int u : peelGroup) {
-          budget -= tetVolume(mesh, u);
-          if (counts) {
-            ++counts->peeled;
-            counts->peeled_volume += tetVolume(mesh, u);
-          }
+        budget -= tetVolume(mesh, t);
+        if (counts) {
+          ++counts->peeled;
+          counts->peeled_volume += tetVolume(mesh, t);
         }
       }
     }
@@ -1207,7 +1183,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
               for (int k = 0; k < 4; ++k) p[k] = mesh.T(*s, k) == n ? y : pos(mesh.T(*s, k));
               dv += (p[1] - p[0]).dot((p[2] - p[0]).cross(p[3] - p[0])) / 6.0 - tetVolume(mesh, *s);
             }
-            if (std::abs(dv) > budget) continue;
+            if (std::abs(dv) > moveBudget || std::abs(dv) > options.move_volume_fraction * edgeTet) continue;
           }
           double q = 0;
           if (starAbove(n, y, wt, best, &q)) {
@@ -1219,7 +1195,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
         }
       }
       if (best > before) {
-        budget -= bestDv;
+        moveBudget -= bestDv;
         largest = std::max(largest, (bestX - x).norm());
         mesh.X.row(n) = bestX.transpose();
         didMove[n] = 1;

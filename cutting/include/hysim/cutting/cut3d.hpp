@@ -71,15 +71,16 @@ struct Optimize3DOptions {
   // whose faces meet at more than this angle), with exactly two ridge edges, slide along them
   // (nodes on the cut then back onto the cut). 0 keeps them fixed.
   double ridge_deg = 30.0;
+  // Moves on curved surfaces (cut, curved boundary, ridges) change the volume a little (the
+  // faces are chords): each by at most this fraction of a regular tet of the local edge...
+  double move_volume_fraction = 0.02;
+  // ... and all of them together by at most this fraction of the mesh's volume.
+  double move_volume_budget = 2e-5;
   // Tets below this q* near the cut are retriangulated with their neighbours (2-3 and 3-2
   // flips of interior faces and edges, within one material) where that raises the worst q*
   // of the tets involved. 0 disables.
   double flip_quality = 0.1;
   double peel_quality = 0.03;
-  // A sliver that cannot be peeled alone (the boundary would pinch at one of its nodes) is
-  // peeled together with its face neighbours below this q*, if that keeps the mesh manifold.
-  // 0 disables.
-  double peel_group_quality = 0.12;
   double collapse_fraction = 0.25;  // edges with an end on the cut shorter than this x their tet's mean edge
   double collapse_volume_fraction = 0.1;  // a collapse changes its star's volume by at most this
   // ... of the star or, where the star is smaller, of a regular tet with the cut's local edge.
