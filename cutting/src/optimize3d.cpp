@@ -76,8 +76,8 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   if (region.seeds.empty() || N == 0) return;
   const bool plane = region.surface && region.surface->isPlane();
   // The repairs for curved cut surfaces (shaving): curved boundaries and ridges move, slivers
-  // are peeled in groups and flipped, snaps and collapses measure volume against the local
-  // edge; plane cuts keep the plane-cut behaviour.
+  // are flipped, snaps and collapses measure volume against the local edge; plane cuts keep
+  // the plane-cut behaviour.
   const bool curved = region.surface != nullptr && !plane;
   std::vector<std::uint8_t> onCut = region.on_cut;  // grows: nodes snapped onto the cut here
   const double cosFlat = std::cos(options.boundary_flat_deg * M_PI / 180.0);
@@ -167,9 +167,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   // Moves on curved surfaces: each within move_volume_fraction of a regular tet of the local
   // edge, all together within move_volume_budget of the mesh's volume.
   double moveBudget = meshVolume * options.move_volume_budget;
-  const double refVolume = curved && options.collapse_volume_fraction_of_edge_tet
-                               ? region.edge_length * region.edge_length * region.edge_length / (6.0 * std::sqrt(2.0))
-                               : 0.0;
+  const double refVolume = curved && options.collapse_volume_fraction_of_edge_tet ? edgeTet : 0.0;
   auto pos = [&](int i) -> Vec3 { return mesh.X.row(i).transpose(); };
   // q* of tet t, cached per tet with the node indices and positions it was computed from
   // (a hit needs all of them unchanged, so the value is exactly what radiusRatio returns).
