@@ -61,6 +61,8 @@ struct Optimize3DOptions {
   bool move_cut_nodes = true;
   bool move_boundary_nodes = true;
   double boundary_flat_deg = 20.0;
+  // The next five options and collapse_volume_fraction_of_edge_tet act on curved cut surfaces
+  // only (shaving sweeps); plane cuts are unaffected.
   // Curved boundaries: a boundary node off the cut whose faces are within this angle of
   // their mean normal (but not within boundary_flat_deg) moves on its boundary faces as they
   // are (the tangent move is put back onto the nearest of them), which keeps the boundary's
