@@ -56,6 +56,7 @@ struct RunArgs {
   std::string report;
   std::string chips;  // empty: the scene's
   bool quiet = false;
+  std::string dump_cuts;  // folder for each pass's cut input (debugging)
 };
 
 int runCommand(const RunArgs& args) {
@@ -66,6 +67,12 @@ int runCommand(const RunArgs& args) {
   if (args.chips == "simulate") scene->chips.mode = engine::ChipSettings::Mode::Simulate;
   auto sim = engine::Simulation::create(*scene);
   if (!sim.ok()) return fail(sim.error());
+  if (!args.dump_cuts.empty()) {
+    std::error_code ec;
+    fs::create_directories(args.dump_cuts, ec);
+    if (ec) return fail("cannot create folder '" + args.dump_cuts + "': " + ec.message());
+    (*sim)->setCutDumpDir(args.dump_cuts);
+  }
 
   std::unique_ptr<render::OffscreenRenderer> renderer;
   engine::RunOptions options;
@@ -150,6 +157,11 @@ int main(int argc, char** argv) {
   run_cmd->add_option("--chips", run.chips, "Override the scene's chips mode: remove or simulate")
       ->check(CLI::IsMember({"remove", "simulate"}));
   run_cmd->add_flag("--quiet", run.quiet, "Print nothing but errors");
+  run_cmd->add_option("--dump-cuts", run.dump_cuts,
+                      "Debugging: write each pass's cut input into this folder (pass_NNN_mesh.msh, the rest mesh "
+                      "before the cut; pass_NNN_surface.msh, the cut surface; full precision). "
+                      "`hysim cut DIR/pass_NNN_mesh.msh --surface DIR/pass_NNN_surface.msh --method hybrid` repeats "
+                      "the pass's cut");
 
   std::string stats_path;
   bool stats_json = false;

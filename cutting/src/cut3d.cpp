@@ -927,7 +927,9 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
 
   std::vector<std::uint8_t> peeled;  // #M1: slivers the optimisation removed
   // 5. Local optimisation (hybrid), from the nodes the cut created, moved or separated.
-  if (options.method == CutMethod::Hybrid && options.optimize.enabled && !cutNodes.empty()) {
+  // (Also when the surface split edges but made no cut face, e.g. a sweep's edge grazing the
+  // tissue: the splits may leave slivers; then the new nodes are the seeds.)
+  if (options.method == CutMethod::Hybrid && options.optimize.enabled && (!cutNodes.empty() || N1 > N0)) {
     const auto optStart = std::chrono::steady_clock::now();
     CutRegion region;
     region.surface = &surface;
@@ -935,6 +937,8 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
     region.on_cut.assign(on.begin(), on.end());
     region.on_cut.resize(N1, 1);
     region.seeds = cutNodes;
+    if (cutNodes.empty())
+      for (int i = N0; i < N1; ++i) region.seeds.push_back(i);
     for (const auto& ce : crossed)
       region.edge_length += (input.X.row(ce.a) - input.X.row(ce.b)).norm() / static_cast<double>(crossed.size());
     region.seeds.insert(region.seeds.end(), moved.begin(), moved.end());

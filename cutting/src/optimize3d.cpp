@@ -9,6 +9,14 @@
 //    boundary_flat_deg of the area-weighted normal), and only perpendicular to that normal:
 //    the volume of a mesh is linear in one node's position with gradient (1/3) * the sum of
 //    its boundary faces' area vectors, so such a move keeps the volume exactly.
+// On a curved cut (shaving: the loop's swept strip skims the tissue at shallow angles and
+// leaves thin wedges between the cut and the boundary, and rough boundaries from earlier
+// passes), more is allowed, within the volume budget: cut nodes slide on the cut where their
+// cut faces are within boundary_curved_deg; boundary nodes there move on their own boundary
+// faces; rim nodes (cut meets boundary) and crease nodes slide along their ridge (these moves
+// within a small volume budget of their own); 2-3 and 3-2 flips repair
+// slivers whose nodes cannot move; snaps and collapses may change a tiny star's volume by a
+// fraction of a regular tet of the local edge. Plane cuts are as before.
 // Candidate moves (ascent along the gradient of the worst incident element's q*, a damped
 // spring step toward the local mean edge length, a push away from the face opposite the
 // node in its worst element; each tried at decreasing lengths) are kept only if no incident
@@ -17,6 +25,7 @@
 #include <array>
 #include <bit>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include "hysim/cutting/cut3d.hpp"
@@ -29,10 +38,33 @@ namespace {
 using Vec3 = Eigen::Vector3d;
 constexpr int kFace[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
 
-enum class Freedom { Free, Plane, Surface, Fixed };
+enum class Freedom { Free, Plane, Surface, Fan, Ridge, Fixed };
+
+// The point of triangle (a, b, c) nearest to p.
+Eigen::Vector3d nearestOnTriangle(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                                  const Eigen::Vector3d& c) {
+  const Eigen::Vector3d ab = b - a, ac = c - a, ap = p - a;
+  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0 && d2 <= 0) return a;
+  const Eigen::Vector3d bp = p - b;
+  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0 && d4 <= d3) return b;
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return a + (d1 / (d1 - d3)) * ab;
+  const Eigen::Vector3d cp = p - c;
+  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0 && d5 <= d6) return c;
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return a + (d2 / (d2 - d6)) * ac;
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) return b + ((d4 - d3) / ((d4 - d3) + (d5 - d6))) * (c - b);
+  const double denom = 1.0 / (va + vb + vc);
+  return a + ab * (vb * denom) + ac * (vc * denom);
+}
 struct Constraint {
   Freedom kind = Freedom::Fixed;
   Vec3 normal = Vec3::Zero();  // Plane: moves are perpendicular to it
+  Vec3 ridge[2];               // Ridge: the two neighbours along the ridge
 };
 
 }  // namespace
@@ -43,8 +75,16 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   dead->assign(M, 0);
   if (region.seeds.empty() || N == 0) return;
   const bool plane = region.surface && region.surface->isPlane();
+  // The repairs for curved cut surfaces (shaving): curved boundaries and ridges move, slivers
+  // are flipped, snaps and collapses measure volume against the local edge; plane cuts keep
+  // the plane-cut behaviour.
+  const bool curved = region.surface != nullptr && !plane;
   std::vector<std::uint8_t> onCut = region.on_cut;  // grows: nodes snapped onto the cut here
   const double cosFlat = std::cos(options.boundary_flat_deg * M_PI / 180.0);
+  const double cosCurved =
+      curved ? std::cos(std::max(options.boundary_flat_deg, options.boundary_curved_deg) * M_PI / 180.0) : cosFlat;
+  const double cosRidge = std::cos(options.ridge_deg * M_PI / 180.0);
+  std::vector<std::array<Vec3, 3>> fan;  // constraintOf's Fan: the node's boundary faces
 
   // Node -> tets of the whole mesh (one O(#T) pass; everything else is local), live tets in
   // index order. After edge collapses the lists of the nodes whose tets died or changed are
@@ -66,8 +106,10 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       touchedList.push_back(n);
     }
   };
+  std::vector<std::int32_t> killed;  // tets removed here, in order (their slots may be reused)
   auto kill = [&](int t) {
     (*dead)[t] = 1;
+    killed.push_back(t);
     for (int k = 0; k < 4; ++k) touch(mesh.T(t, k));
   };
   bool built = false;
@@ -116,7 +158,16 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
                x3 = mesh.X.row(mesh.T(t, 3));
     budget += (x1 - x0).dot((x2 - x0).cross(x3 - x0)) / 6.0;
   }
+  const double meshVolume = budget;
   budget *= options.volume_budget;
+  // A collapse or snap may change its star's volume by collapse_volume_fraction of the star,
+  // or of a regular tet with the local edge length where the star is smaller (a node very
+  // near the cut among tiny tets).
+  const double edgeTet = region.edge_length * region.edge_length * region.edge_length / (6.0 * std::sqrt(2.0));
+  // Moves on curved surfaces: each within move_volume_fraction of a regular tet of the local
+  // edge, all together within move_volume_budget of the mesh's volume.
+  double moveBudget = meshVolume * options.move_volume_budget;
+  const double refVolume = curved && options.collapse_volume_fraction_of_edge_tet ? edgeTet : 0.0;
   auto pos = [&](int i) -> Vec3 { return mesh.X.row(i).transpose(); };
   // q* of tet t, cached per tet with the node indices and positions it was computed from
   // (a hit needs all of them unchanged, so the value is exactly what radiusRatio returns).
@@ -241,8 +292,38 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       allCut = allCut && onCut[bf.u] && onCut[bf.v];
     }
     const bool nodeOnCut = onCut[n] != 0;
+    // A node on a ridge (the rim, where the cut meets the boundary, or a crease of the
+    // boundary) slides along it: exactly two of its boundary edges are ridge edges (between a
+    // cut and a non-cut face, or faces more than ridge_deg apart).
+    auto ridgeOf = [&]() {
+      if (!curved || !(options.ridge_deg > 0)) return false;
+      int found = 0;
+      for (size_t i = 0; i < faces.size(); ++i) {
+        if (faces[i].count != 1) continue;
+        for (int w : {faces[i].u, faces[i].v})
+          for (size_t j = i + 1; j < faces.size(); ++j) {
+            if (faces[j].count != 1 || (faces[j].u != w && faces[j].v != w)) continue;
+            const bool cutI = onCut[faces[i].u] && onCut[faces[i].v] && nodeOnCut;
+            const bool cutJ = onCut[faces[j].u] && onCut[faces[j].v] && nodeOnCut;
+            // (On the cut only the rim counts: the node is put back onto the cut surface.)
+            const bool edge = nodeOnCut ? cutI != cutJ
+                                        : faces[i].area.normalized().dot(faces[j].area.normalized()) < cosRidge;
+            if (!edge) continue;
+            if (found == 2) return false;
+            c.ridge[found++] = pos(w);
+          }
+      }
+      if (found != 2) return false;
+      c.kind = Freedom::Ridge;
+      c.normal = Vec3::Zero();
+      return true;
+    };
     if (nodeOnCut) {
-      if (!options.move_cut_nodes || (boundary && !allCut)) return c;  // rim node (or off)
+      if (!options.move_cut_nodes) return c;
+      if (boundary && !allCut) {  // rim node
+        ridgeOf();
+        return c;
+      }
       if (plane) {
         c.kind = Freedom::Plane;
         c.normal = region.surface->planeNormal();
@@ -254,7 +335,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       // volume changes by second-order amounts), where the cut faces around are smooth.
       c.kind = Freedom::Surface;
       for (const auto& bf : faces)
-        if (bf.count == 1 && bf.area.normalized().dot(c.normal) < cosFlat) c.kind = Freedom::Fixed;
+        if (bf.count == 1 && bf.area.normalized().dot(c.normal) < cosCurved) c.kind = Freedom::Fixed;
       return c;
     }
     if (!boundary) {
@@ -263,9 +344,22 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     }
     if (!options.move_boundary_nodes || sum.norm() == 0) return c;
     c.normal = sum.normalized();
-    for (const auto& bf : faces)
-      if (bf.count == 1 && bf.area.normalized().dot(c.normal) < cosFlat) return c;
     c.kind = Freedom::Plane;
+    for (const auto& bf : faces) {
+      if (bf.count != 1) continue;
+      const double cosine = bf.area.normalized().dot(c.normal);
+      if (cosine < cosCurved) {
+        c.kind = Freedom::Fixed;
+        ridgeOf();
+        return c;
+      }
+      if (cosine < cosFlat) c.kind = Freedom::Fan;
+    }
+    if (c.kind == Freedom::Fan) {  // the node stays on its boundary faces as they are now
+      fan.clear();
+      for (const auto& bf : faces)
+        if (bf.count == 1) fan.push_back({pos(n), pos(bf.u), pos(bf.v)});
+    }
     return c;
   };
   // A node off the cut stays strictly on its side of the surface.
@@ -441,6 +535,190 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   };
   peel();
 
+  // Flips: a poor tet (q* below flip_quality) with all its nodes held in place is repaired by
+  // retriangulating it with its neighbours: 2-3 (the tet and its neighbour across a face
+  // become three tets around the edge between their far nodes) and 3-2 (the three tets
+  // around an interior edge become two across the triangle of their other nodes). Only
+  // interior faces and edges change, within one material: the boundary, the cut and the
+  // volume stay exactly. Kept when the worst q* of the tets involved rises; the best flip
+  // of a tet is taken. A 2-3 flip reuses the slot of a removed tet (none free: no 2-3).
+  std::vector<std::int32_t> freeSlots;
+  auto flips = [&]() {
+    if (!curved || !(options.flip_quality > 0)) return;
+    freeSlots.assign(killed.begin(), killed.end());
+    std::sort(freeSlots.begin(), freeSlots.end());
+    freeSlots.erase(std::unique(freeSlots.begin(), freeSlots.end()), freeSlots.end());
+    std::vector<std::int32_t> cands, edgeTets;
+    auto vol6 = [&](int a, int b, int c, int d) {
+      const Vec3 p0 = pos(a);
+      return (pos(b) - p0).dot((pos(c) - p0).cross(pos(d) - p0));
+    };
+    auto q4 = [&](int a, int b, int c, int d) {
+      return vol6(a, b, c, d) > 0 ? radiusRatio(pos(a), pos(b), pos(c), pos(d)) : -1.0;
+    };
+    auto setTet = [&](int t, int a, int b, int c, int d) {
+      const int v[4] = {a, b, c, d};
+      for (int k = 0; k < 4; ++k) {
+        touch(mesh.T(t, k));
+        mesh.T(t, k) = v[k];
+        touch(v[k]);
+        gained.emplace_back(v[k], t);
+      }
+    };
+    for (int round = 0; round < 3; ++round) {
+      regionTets(cands);
+      cands.erase(std::remove_if(cands.begin(), cands.end(), [&](int t) { return !(tetQ(t) < options.flip_quality); }),
+                  cands.end());
+      int done = 0;
+      for (int t : cands) {
+        if ((*dead)[t]) continue;
+        const double qt = tetQ(t);
+        if (!(qt < options.flip_quality)) continue;
+        // Best flip: kind 0 = 2-3 across face f (neighbour u), kind 1 = 3-2 about edge (i, j).
+        double best = qt;
+        int bestKind = -1, bestF = -1, bestU = -1, bestI = -1, bestJ = -1;
+        std::int32_t ring[3] = {-1, -1, -1}, ringTets[3] = {-1, -1, -1};
+        // 2-3.
+        const bool slot = [&]() {
+          while (!freeSlots.empty() && !(*dead)[freeSlots.back()]) freeSlots.pop_back();
+          return !freeSlots.empty();
+        }();
+        for (int f = 0; f < 4 && slot; ++f) {
+          const int a = mesh.T(t, kFace[f][0]), b = mesh.T(t, kFace[f][1]), c = mesh.T(t, kFace[f][2]),
+                    d = mesh.T(t, f);
+          int u = -1;
+          for (const std::int32_t *s = starB(a), *sEnd = starE(a); s < sEnd && u < 0; ++s) {
+            if (*s == t || (*dead)[*s]) continue;
+            int hits = 0;
+            for (int k = 0; k < 4; ++k) hits += mesh.T(*s, k) == a || mesh.T(*s, k) == b || mesh.T(*s, k) == c;
+            if (hits == 3) u = *s;
+          }
+          if (u < 0 || mesh.material(u) != mesh.material(t)) continue;
+          int e = -1;
+          for (int k = 0; k < 4; ++k)
+            if (mesh.T(u, k) != a && mesh.T(u, k) != b && mesh.T(u, k) != c) e = mesh.T(u, k);
+          const double old = std::min(qt, tetQ(u));
+          // The new edge (d, e) is no shorter than the shortest edge of the two tets.
+          double shortest = std::numeric_limits<double>::infinity();
+          for (int tt : {t, u})
+            for (int i = 0; i < 4; ++i)
+              for (int j = i + 1; j < 4; ++j)
+                shortest = std::min(shortest, (pos(mesh.T(tt, i)) - pos(mesh.T(tt, j))).squaredNorm());
+          if ((pos(d) - pos(e)).squaredNorm() < shortest) continue;
+          // (d, e) must not be an edge already (where the mesh folds, it could be).
+          bool exists = false;
+          for (const std::int32_t *s = starB(d), *sEnd = starE(d); s < sEnd && !exists; ++s)
+            if (!(*dead)[*s])
+              for (int k = 0; k < 4; ++k) exists = exists || mesh.T(*s, k) == e;
+          if (exists) continue;
+          // (d, a, b, c) with kFace's order is positive when the face is (a, b, c) seen from
+          // outside, i.e. vol(a, b, c, d) < 0 in this convention: use the tet's own order.
+          // New tets: t with one face node replaced by e.
+          int v[4];
+          for (int k = 0; k < 4; ++k) v[k] = mesh.T(t, k);
+          double qn = 1.0;
+          for (int r = 0; r < 3 && qn > best; ++r) {
+            const int fk = kFace[f][r];
+            int w[4] = {v[0], v[1], v[2], v[3]};
+            w[fk] = e;
+            qn = std::min(qn, q4(w[0], w[1], w[2], w[3]));
+          }
+          if (qn > best && qn > old) {
+            best = qn;
+            bestKind = 0;
+            bestF = f;
+            bestU = u;
+            bestI = e;
+          }
+        }
+        // 3-2.
+        for (int i = 0; i < 4; ++i)
+          for (int j = i + 1; j < 4; ++j) {
+            const int a = mesh.T(t, i), b = mesh.T(t, j);
+            edgeTets.clear();
+            for (const std::int32_t *s = starB(a), *sEnd = starE(a); s < sEnd; ++s) {
+              if ((*dead)[*s]) continue;
+              int hits = 0;
+              for (int k = 0; k < 4; ++k) hits += mesh.T(*s, k) == a || mesh.T(*s, k) == b;
+              if (hits == 2) edgeTets.push_back(*s);
+            }
+            if (edgeTets.size() != 3) continue;
+            bool sameMat = true;
+            for (int u : edgeTets) sameMat = sameMat && mesh.material(u) == mesh.material(t);
+            if (!sameMat) continue;
+            // The other two nodes of each tet; a closed ring uses each of three nodes twice.
+            std::int32_t others[6], m = 0;
+            for (int u : edgeTets)
+              for (int k = 0; k < 4; ++k)
+                if (mesh.T(u, k) != a && mesh.T(u, k) != b) others[m++] = mesh.T(u, k);
+            if (m != 6) continue;
+            std::int32_t p[3], np = 0;
+            bool closed = true;
+            for (int k = 0; k < 6 && closed; ++k) {
+              int uses = 0;
+              for (int l = 0; l < 6; ++l) uses += others[l] == others[k];
+              closed = uses == 2;
+              bool seen = false;
+              for (int l = 0; l < np; ++l) seen = seen || p[l] == others[k];
+              if (!seen && np < 3) p[np++] = others[k];
+            }
+            if (!closed || np != 3) continue;
+            // The triangle (p0, p1, p2) must not be a face already (where the mesh folds).
+            bool exists = false;
+            for (const std::int32_t *s = starB(p[0]), *sEnd = starE(p[0]); s < sEnd && !exists; ++s) {
+              if ((*dead)[*s]) continue;
+              int hits = 0;
+              for (int k = 0; k < 4; ++k) hits += mesh.T(*s, k) == p[1] || mesh.T(*s, k) == p[2];
+              exists = hits == 2;
+            }
+            if (exists) continue;
+            double old = 1.0;
+            for (int u : edgeTets) old = std::min(old, tetQ(u));
+            const double va = vol6(p[0], p[1], p[2], a);
+            const int top = va > 0 ? a : b, bottom = va > 0 ? b : a;
+            const double qn = std::min(q4(p[0], p[1], p[2], top), q4(p[0], p[2], p[1], bottom));
+            if (qn > best && qn > old) {
+              best = qn;
+              bestKind = 1;
+              bestI = top;
+              bestJ = bottom;
+              for (int k = 0; k < 3; ++k) {
+                ring[k] = p[k];
+                ringTets[k] = edgeTets[k];
+              }
+            }
+          }
+        if (bestKind == 0) {
+          int v[4];
+          for (int k = 0; k < 4; ++k) v[k] = mesh.T(t, k);
+          const int e = bestI, u = bestU;
+          const int extra = freeSlots.back();
+          freeSlots.pop_back();
+          const int slots[3] = {t, u, extra};
+          (*dead)[extra] = 0;
+          mesh.material(extra) = mesh.material(t);
+          for (int r = 0; r < 3; ++r) {
+            int w[4] = {v[0], v[1], v[2], v[3]};
+            w[kFace[bestF][r]] = e;
+            setTet(slots[r], w[0], w[1], w[2], w[3]);
+          }
+          if (!(*dead)[u]) touch(mesh.T(u, 0));
+          ++done;
+          if (counts) ++counts->flips;
+        } else if (bestKind == 1) {
+          setTet(ringTets[0], ring[0], ring[1], ring[2], bestI);
+          setTet(ringTets[1], ring[0], ring[2], ring[1], bestJ);
+          kill(ringTets[2]);
+          freeSlots.push_back(ringTets[2]);
+          ++done;
+          if (counts) ++counts->flips;
+        }
+        if (bestKind >= 0) buildStars();
+      }
+      if (done == 0) break;
+    }
+  };
+
   // Edge collapse on the cut: an edge with an end on the cut that is short (below
   // collapse_fraction of its tet's mean edge) or belongs to a poor tet (q* below
   // quality_target) is collapsed into its end on the cut, which keeps its place (so the cut
@@ -522,7 +800,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
           after += (p[1] - p[0]).dot((p[2] - p[0]).cross(p[3] - p[0])) / 6.0;
         }
         const double change = std::abs(after - before);
-        if (change > options.collapse_volume_fraction * before || change > budget) continue;
+        if (change > options.collapse_volume_fraction * std::max(before, refVolume) || change > budget) continue;
         double oldMin = 1.0;
         for (int t : dying) oldMin = std::min(oldMin, tetQ(t));
         for (int t : changing) oldMin = std::min(oldMin, tetQ(t));
@@ -666,8 +944,9 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
         }
       }
       if (dying.empty() || changing.empty() || newMin < oldMin ||
-          change > options.collapse_volume_fraction * before || change > budget)
+          change > options.collapse_volume_fraction * std::max(before, refVolume) || change > budget) {
         return false;
+      }
       groupFrom.clear();
       for (size_t g = 0; g < group.size(); ++g) {
         groupFrom.push_back(pos(group[g]));
@@ -746,6 +1025,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   };
   snapNear();
   collapseEdges();
+  flips();
 
   // Nodes up to `rings` edge steps from the seeds may move.
   std::vector<std::int8_t> ring(N, -1);
@@ -801,7 +1081,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       const double before = starWorst(n, &wt);
       if (before < 0 || before >= options.quality_target || wt < 0) continue;
       auto project = [&](Vec3 d) {
-        if (c.kind == Freedom::Plane || c.kind == Freedom::Surface) d -= d.dot(c.normal) * c.normal;
+        if (c.kind != Freedom::Free && c.kind != Freedom::Ridge) d -= d.dot(c.normal) * c.normal;
         return d;
       };
       // Unit direction of the allowed part of d (zero when d is (nearly) all normal: the
@@ -852,7 +1132,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       push = unitIn(push);
       const Vec3 spring = options.step_gain * 2.0 * force / deg;
       const Vec3 dirs[3] = {0.25 * h * grad, spring.norm() * unitIn(spring), 0.3 * h * push};
-      double best = before;
+      double best = before, bestDv = 0;
       Vec3 bestX = x;
       for (const Vec3& d : dirs) {
         if (d.squaredNorm() == 0) continue;
@@ -860,16 +1140,60 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
         for (int tries = 0; tries < 5; ++tries, step *= 0.5) {
           Vec3 y = x + step * d;
           if (c.kind == Freedom::Surface) region.surface->signedDistance(Vec3(y), &y);
+          if (c.kind == Freedom::Ridge) {  // along the ridge edge nearest the move, at most 0.45 of it
+            const Vec3 d = y - x;
+            double bestAlong = 0;
+            Vec3 to = x;
+            for (const Vec3& r : c.ridge) {
+              const Vec3 e = r - x;
+              const double len = e.norm();
+              if (!(len > 0)) continue;
+              const double along = std::min(d.dot(e) / len, 0.45 * len);
+              if (along > bestAlong) {
+                bestAlong = along;
+                to = x + (along / len) * e;
+              }
+            }
+            if (!(bestAlong > 0)) continue;
+            y = to;
+            if (onCut[n]) region.surface->signedDistance(Vec3(y), &y);
+          }
+          if (c.kind == Freedom::Fan) {
+            Vec3 best = y;
+            double bestD = std::numeric_limits<double>::infinity();
+            for (const auto& tri : fan) {
+              const Vec3 z = nearestOnTriangle(y, tri[0], tri[1], tri[2]);
+              const double dz = (z - y).squaredNorm();
+              if (dz < bestD) {
+                bestD = dz;
+                best = z;
+              }
+            }
+            y = best;
+          }
           if (!sideKept(n, x, y)) continue;
+          // Moves on a curved surface change the volume a little (the faces are chords): within the budget.
+          double dv = 0;
+          if (curved && (c.kind == Freedom::Surface || c.kind == Freedom::Fan || c.kind == Freedom::Ridge)) {
+            for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s) {
+              if ((*dead)[*s]) continue;
+              Vec3 p[4];
+              for (int k = 0; k < 4; ++k) p[k] = mesh.T(*s, k) == n ? y : pos(mesh.T(*s, k));
+              dv += (p[1] - p[0]).dot((p[2] - p[0]).cross(p[3] - p[0])) / 6.0 - tetVolume(mesh, *s);
+            }
+            if (std::abs(dv) > moveBudget || std::abs(dv) > options.move_volume_fraction * edgeTet) continue;
+          }
           double q = 0;
           if (starAbove(n, y, wt, best, &q)) {
             best = q;
             bestX = y;
+            bestDv = std::abs(dv);
             break;
           }
         }
       }
       if (best > before) {
+        moveBudget -= bestDv;
         largest = std::max(largest, (bestX - x).norm());
         mesh.X.row(n) = bestX.transpose();
         didMove[n] = 1;
@@ -886,6 +1210,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   if (counts) counts->iterations = it;
   snapNear();  // moves may have made new short edges on the cut
   collapseEdges();
+  flips();
   peel();
   if (moved)
     for (int n = 0; n < N; ++n)

@@ -22,6 +22,7 @@ struct OptimizeCounts {
   int peeled = 0;
   int collapsed = 0;
   int late_snaps = 0;
+  int flips = 0;
   std::vector<std::int32_t> onto_cut;  // the nodes late snapping moved onto the cut
   double peeled_volume = 0;
 };

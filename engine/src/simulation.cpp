@@ -7,6 +7,7 @@
 #include <assimp/Importer.hpp>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 
 #include "hysim/cutting/cut3d.hpp"
@@ -553,6 +554,14 @@ void Simulation::finishPass() {
   auto surface = cutting::CutSurface::triangles(rv, rf);
   if (!surface.ok()) return fail(surface.error());
   timer.lap(&rec.map_ms);
+  if (!cut_dump_dir_.empty()) {  // debugging (setCutDumpDir): the cut's input, to repeat offline
+    char name[64];
+    std::snprintf(name, sizeof(name), "/pass_%03d_", static_cast<int>(passes_.size()) + 1);
+    const cutting::TriMesh sweep_mesh{rv, rf, cutting::Labels::Zero(rf.rows())};
+    Status st = cutting::writeMesh(cut_dump_dir_ + name + "mesh.msh", mesh_);
+    if (st.ok()) st = cutting::writeMesh(cut_dump_dir_ + name + "surface.msh", sweep_mesh);
+    if (!st.ok()) return fail("--dump-cuts: " + st.error());
+  }
   cutting::Cut3DOptions options;
   options.method = cutting::CutMethod::Hybrid;
   auto cut = cutting::cut3d(mesh_, *surface, options);

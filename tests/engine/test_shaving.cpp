@@ -187,5 +187,37 @@ TEST(Shaving, SamePassTwiceGivesTheSameState) {
   EXPECT_EQ((*a)->stateHash(), (*b)->stateHash());
 }
 
+// setCutDumpDir: the pass writes its cut's input; cutting the written mesh with the written
+// surface (default options, as the pass) repeats the pass's cut.
+TEST(Shaving, DumpedCutInputRepeatsThePassesCut) {
+  auto scene = loadScene(writeSlabScene(true));
+  ASSERT_TRUE(scene.ok()) << scene.error();
+  auto sim = Simulation::create(*scene);
+  ASSERT_TRUE(sim.ok()) << sim.error();
+  const fs::path dir = fs::path(HYSIM_TEST_OUTPUT_DIR) / "shaving" / "dump";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  (*sim)->setCutDumpDir(dir.string());
+  for (int i = 0; i < 1300; ++i) (*sim)->step();
+  ASSERT_EQ((*sim)->passes().size(), 1u);
+  const PassRecord& pass = (*sim)->passes()[0];
+  ASSERT_FALSE(pass.cut_failed) << pass.message;
+  auto mesh = cutting::readTetMesh((dir / "pass_001_mesh.msh").string());
+  ASSERT_TRUE(mesh.ok()) << mesh.error();
+  auto tris = cutting::readTriMesh((dir / "pass_001_surface.msh").string());
+  ASSERT_TRUE(tris.ok()) << tris.error();
+  EXPECT_FALSE(fs::exists(dir / "pass_002_mesh.msh"));
+  EXPECT_EQ(mesh->numTets(), 6 * 15 * 10 * 5);  // the slab before its first cut
+  auto surface = cutting::CutSurface::triangles(tris->X, tris->F);
+  ASSERT_TRUE(surface.ok()) << surface.error();
+  auto cut = cutting::cut3d(*mesh, *surface, cutting::Cut3DOptions{});
+  ASSERT_TRUE(cut.ok()) << cut.error();
+  EXPECT_EQ(cut->report.crossed_edges, pass.crossed_edges);
+  EXPECT_EQ(cut->report.snapped_nodes, pass.snapped_nodes);
+  EXPECT_EQ(cut->report.split_edges, pass.split_edges);
+  EXPECT_EQ(cut->report.duplicated_nodes, pass.duplicated_nodes);
+  EXPECT_EQ(cut->report.cut_faces, pass.cut_faces);
+}
+
 }  // namespace
 }  // namespace hysim::engine

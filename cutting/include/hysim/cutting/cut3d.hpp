@@ -61,9 +61,32 @@ struct Optimize3DOptions {
   bool move_cut_nodes = true;
   bool move_boundary_nodes = true;
   double boundary_flat_deg = 20.0;
+  // The next five options and collapse_volume_fraction_of_edge_tet act on curved cut surfaces
+  // only (shaving sweeps); plane cuts are unaffected.
+  // Curved boundaries: a boundary node off the cut whose faces are within this angle of
+  // their mean normal (but not within boundary_flat_deg) moves on its boundary faces as they
+  // are (the tangent move is put back onto the nearest of them), which keeps the boundary's
+  // shape to within the chords; a node on a curved cut slides on the cut where its cut faces
+  // are within this angle. Below boundary_flat_deg: as that.
+  double boundary_curved_deg = 50.0;
+  // Nodes on a ridge (the rim, where the cut meets the boundary; a crease of the boundary,
+  // whose faces meet at more than this angle), with exactly two ridge edges, slide along them
+  // (nodes on the cut then back onto the cut). 0 keeps them fixed.
+  double ridge_deg = 30.0;
+  // Moves on curved surfaces (cut, curved boundary, ridges) change the volume a little (the
+  // faces are chords): each by at most this fraction of a regular tet of the local edge...
+  double move_volume_fraction = 0.02;
+  // ... and all of them together by at most this fraction of the mesh's volume.
+  double move_volume_budget = 2e-5;
+  // Tets below this q* near the cut are retriangulated with their neighbours (2-3 and 3-2
+  // flips of interior faces and edges, within one material) where that raises the worst q*
+  // of the tets involved. 0 disables.
+  double flip_quality = 0.1;
   double peel_quality = 0.03;
   double collapse_fraction = 0.25;  // edges with an end on the cut shorter than this x their tet's mean edge
   double collapse_volume_fraction = 0.1;  // a collapse changes its star's volume by at most this
+  // ... of the star or, where the star is smaller, of a regular tet with the cut's local edge.
+  bool collapse_volume_fraction_of_edge_tet = true;
   double volume_budget = 5e-4;  // peeling + collapses change the mesh volume by at most this (relative)
 };
 

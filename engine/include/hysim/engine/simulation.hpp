@@ -112,6 +112,11 @@ class Simulation {
   // Puts back a state saved from this simulation (benchmarks restore one before each batch).
   // Same topology only; copies into the existing buffers.
   void restoreState(const sim::State& saved) { state_ = saved; }
+  // Debugging: when set, each pass writes the cut's input into this folder before cutting:
+  // the rest mesh (pass_NNN_mesh.msh) and the cut surface (pass_NNN_surface.msh), NNN the
+  // pass's number from 1, full precision; `hysim cut MESH --surface SURFACE --method hybrid`
+  // then repeats the pass's cut exactly. Empty (the default): nothing is written.
+  void setCutDumpDir(std::string dir) { cut_dump_dir_ = std::move(dir); }
 
  private:
   Simulation() = default;
@@ -177,6 +182,7 @@ class Simulation {
   bool cutting_ = false;
   int topology_version_ = 0;
   std::vector<PassRecord> passes_;
+  std::string cut_dump_dir_;  // see setCutDumpDir
   std::vector<std::uint8_t> on_cut_;  // #N: node lies on a cut surface (drawn as cut tissue)
   std::vector<std::uint8_t> anchored_;  // #N: rest position in an anchor region (fixed)
   std::vector<double> tet_quality_;     // #T: q* of each element (rest shape), for q_min
