@@ -165,6 +165,7 @@ Status Simulation::setTopology(cutting::TetMesh rest_mesh, const sim::NodeVector
   if (!model.ok()) return Error{model.error()};
   model_ = std::move(model.value());
   resetState(x, v);
+  if (!matchFaces(mesh_, face_next_)) face_next_.clear();
   timer.lap(timing ? &timing->model_ms : nullptr);
   tet_quality_.resize(static_cast<size_t>(mesh_.numTets()));
   for (int t = 0; t < mesh_.numTets(); ++t) tet_quality_[t] = tetQuality(mesh_, t);
@@ -606,9 +607,12 @@ void Simulation::finishPass() {
   for (int j : change.moved_nodes) reanchor(j);
   for (int j : change.cut_nodes) reanchor(j);
   // Chips: pieces connected to no anchored node are removed (their volume is resected).
+  // Face neighbours of the cut mesh: from the previous mesh's, rematching only the faces
+  // near the cut (all faces when that cannot be done).
   std::vector<int> face_next;
   Pieces comps;
-  if (matchFaces(after, face_next)) {
+  if (updateFaces(mesh_, face_next_, after, change.node_old_to_new, change.element_old_to_new, face_next) ||
+      matchFaces(after, face_next)) {
     comps = tetPieces(after, face_next, anchored_after);
   } else {  // not reached for a valid mesh
     std::vector<int> anchored;
@@ -669,6 +673,22 @@ void Simulation::finishPass() {
     for (size_t k = 0; k < keep_tets.size(); ++k)
       for (int f = 0; f < 4; ++f) kept_boundary[4 * k + f] = face_next[4 * static_cast<size_t>(keep_tets[k]) + f] < 0;
   }
+  // The kept mesh's face neighbours, for the next pass (a kept tet's neighbours are kept).
+  std::vector<int> kept_next;
+  if (!face_next.empty()) {
+    std::vector<int> kept_of(static_cast<size_t>(after.numTets()), -1);
+    for (size_t k = 0; k < keep_tets.size(); ++k) kept_of[keep_tets[k]] = static_cast<int>(k);
+    kept_next.resize(4 * keep_tets.size());
+    for (size_t k = 0; k < keep_tets.size() && !kept_next.empty(); ++k)
+      for (int f = 0; f < 4; ++f) {
+        const int p = face_next[4 * static_cast<size_t>(keep_tets[k]) + f];
+        if (p >= 0 && kept_of[p / 4] < 0) {  // not reached: pieces are closed under faces
+          kept_next.clear();
+          break;
+        }
+        kept_next[4 * k + f] = p < 0 ? -1 : 4 * kept_of[p / 4] + p % 4;
+      }
+  }
   // Nodes on a cut surface, this pass's and earlier ones', in the new numbering.
   std::vector<std::uint8_t> on_cut(n, 0);
   for (int i = 0; i < static_cast<int>(change.node_old_to_new.size()); ++i) {
@@ -706,6 +726,7 @@ void Simulation::finishPass() {
   }
   const cutting::TetMesh previous = std::move(mesh_);
   mesh_ = std::move(rest_mesh);
+  face_next_ = std::move(kept_next);
   anchored_ = std::move(anchored_kept);
   resetState(&x_kept, &v_kept);
   rec.stability_nodes = update.stability_nodes;
