@@ -53,32 +53,44 @@ double topEigenvalue(const Model& m, const cutting::Positions& X, const std::vec
     }
   }
   const Eigen::Index n3 = 3 * static_cast<Eigen::Index>(count);
+  // Structure of arrays, a held end pointing at a zero slot past the free ones (its scale
+  // is 0 and its row of the result is dropped): no branches, the same arithmetic as with
+  // them (0 * 0 added or subtracted leaves a value as it is).
+  const size_t ns = springs.size();
+  std::vector<int> ia(ns), ib(ns);
+  std::vector<double> sdx(ns), sdy(ns), sdz(ns), sk(ns), ssa(ns), ssb(ns);
+  for (size_t i = 0; i < ns; ++i) {
+    const LocalSpring& ls = springs[i];
+    ia[i] = 3 * (ls.a >= 0 ? ls.a : count);
+    ib[i] = 3 * (ls.b >= 0 ? ls.b : count);
+    sdx[i] = ls.dx;
+    sdy[i] = ls.dy;
+    sdz[i] = ls.dz;
+    sk[i] = ls.k;
+    ssa[i] = ls.sa;
+    ssb[i] = ls.sb;
+  }
+  Eigen::VectorXd u_pad = Eigen::VectorXd::Zero(n3 + 3), z_pad(n3 + 3);
   auto apply = [&](const Eigen::VectorXd& u, Eigen::VectorXd& z) {
-    z.setZero();
-    for (const LocalSpring& s : springs) {
-      double yx = 0, yy = 0, yz = 0;
-      if (s.b >= 0) {
-        yx += s.sb * u[3 * s.b];
-        yy += s.sb * u[3 * s.b + 1];
-        yz += s.sb * u[3 * s.b + 2];
-      }
-      if (s.a >= 0) {
-        yx -= s.sa * u[3 * s.a];
-        yy -= s.sa * u[3 * s.a + 1];
-        yz -= s.sa * u[3 * s.a + 2];
-      }
-      const double t = s.k * (yx * s.dx + yy * s.dy + yz * s.dz);  // (K y)_b = t d, (K y)_a = -t d
-      if (s.a >= 0) {
-        z[3 * s.a] -= s.sa * t * s.dx;
-        z[3 * s.a + 1] -= s.sa * t * s.dy;
-        z[3 * s.a + 2] -= s.sa * t * s.dz;
-      }
-      if (s.b >= 0) {
-        z[3 * s.b] += s.sb * t * s.dx;
-        z[3 * s.b + 1] += s.sb * t * s.dy;
-        z[3 * s.b + 2] += s.sb * t * s.dz;
-      }
+    u_pad.head(n3) = u;
+    z_pad.setZero();
+    const double* up = u_pad.data();
+    double* zp = z_pad.data();
+    for (size_t i = 0; i < ns; ++i) {
+      const int a = ia[i], b = ib[i];
+      const double sa = ssa[i], sb = ssb[i], dx = sdx[i], dy = sdy[i], dz = sdz[i];
+      const double yx = sb * up[b] - sa * up[a];
+      const double yy = sb * up[b + 1] - sa * up[a + 1];
+      const double yz = sb * up[b + 2] - sa * up[a + 2];
+      const double t = sk[i] * (yx * dx + yy * dy + yz * dz);  // (K y)_b = t d, (K y)_a = -t d
+      zp[a] -= sa * t * dx;
+      zp[a + 1] -= sa * t * dy;
+      zp[a + 2] -= sa * t * dz;
+      zp[b] += sb * t * dx;
+      zp[b + 1] += sb * t * dy;
+      zp[b + 2] += sb * t * dz;
     }
+    z = z_pad.head(n3);
   };
   // Start: the alternating pattern of buildModel's power iteration (excites the highest
   // modes), plus the given vector.
