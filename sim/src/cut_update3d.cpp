@@ -487,24 +487,20 @@ Status updateModelAfterCut3D(Model& model, const cutting::TetMesh& before, const
       // A Lanczos estimate of its own (near the cut it is above every bound carried over).
       m.omega_max = rep.omega_local;
       m.stability_mode = std::move(ritz);
+      // The rest of the mesh stays bounded by the previous estimate if that was one.
+      m.stability_held = rep.global_stability || held_before >= 0 ? 0 : -1;
       rep.held_stability = false;
       carried = false;
     } else {
       m.omega_max = rep.omega_previous;
       m.stability_mode = mapped_mode;
+      m.stability_held = mode_near_cut && held_before >= 0 ? held_before + 1 : held_before;
       rep.held_stability = mode_near_cut;
       carried = true;
     }
     m.critical_dt = stabilityLimit(m.omega_max);
   };
   estimate();
-  // Counted from the last estimate over all nodes: updates whose previous mode was near the
-  // cut (the rest of the mesh bounded by an earlier estimate, whichever value won).
-  if (rep.global_stability) {
-    m.stability_held = 0;
-  } else if (mode_near_cut && held_before >= 0) {
-    m.stability_held = held_before + 1;
-  }
   // Selective mass scaling, as buildModel, on the nodes of the estimate.
   // A carried-over previous estimate is not lowered by mass near the cut: no rounds then.
   if (opt.substeps <= 0 && opt.max_substeps > 0 && substepsFor(m.critical_dt) > opt.max_substeps && !carried) {

@@ -81,8 +81,9 @@ Result<Model> updateModel3D(const Model& before, const cutting::TetMesh& mesh_be
 //    eigenvalue is at most the previous one (Cauchy interlacing), so max(estimate near the
 //    cut, previous omega_max) is not below what the whole mesh's estimate would find away
 //    from the cut, only possibly above it (the mode that set it may have been cut away).
-//    That held bound is used for at most max_held_estimates such updates after an estimate
-//    over all nodes (whether it or the estimate near the cut decides); then, and
+//    That held bound decides omega_max for at most max_held_estimates updates in a row (an
+//    estimate near the cut at or above it ends the run: it is then at least the rest's
+//    bound, about what an estimate over all nodes would find); then, and
 //    when the previous estimate is not a Lanczos one (buildModel's power iteration, which
 //    approaches the top from below, too far to bound anything), a Lanczos estimate over all
 //    free nodes, started from the previous mode, replaces it. Selective mass scaling as buildModel, on the
@@ -95,9 +96,8 @@ struct CutUpdate3DOptions {
   int lanczos_steps = 60;           // at most
   int lanczos_min_steps = 20;       // at least (when the space is that large)
   double lanczos_tolerance = 1e-3;  // relative residual of the top Ritz pair, and its growth over 5 steps
-  // Updates after an estimate over all nodes whose previous mode may be near the cut, with
-  // the previous estimate held as a bound for the rest (Model::stability_held); the next
-  // such update estimates over all nodes again. 0 = always over all nodes.
+  // Updates in a row whose omega_max may be the previous one held as a bound after its
+  // mode was near the cut (Model::stability_held); 0 = estimate over all nodes instead.
   int max_held_estimates = 4;
 };
 
