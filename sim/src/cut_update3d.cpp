@@ -111,7 +111,7 @@ double topEigenvalue(const Model& m, const cutting::Positions& X, const std::vec
     q.normalize();
   }
   const int max_steps = std::max(1, std::min(options.lanczos_steps, static_cast<int>(n3)));
-  const bool reorthogonalise = n3 <= 30000;  // cheap near a cut; not worth it over a whole mesh
+  const bool reorthogonalise = n3 <= 3000;  // cheap near a small cut; not worth it over many nodes
   Eigen::MatrixXd Q(n3, max_steps);
   std::vector<double> alpha, beta, history;
   Eigen::VectorXd z(n3);
