@@ -56,6 +56,19 @@ Prepared prepare(const std::string& path, const std::string& name) {
   auto model = hysim::sim::buildModel(p.mesh, {wall, myoma}, fixed, {});
   if (!model.ok()) return p;
   p.model = std::move(*model);
+  // The simulator's model after its first pass: a Lanczos estimate over all free nodes (an
+  // update with nothing changed, forced global), which later updates may hold as a bound.
+  {
+    hysim::cutting::TopologyChange identity;
+    identity.old_num_nodes = identity.new_num_nodes = p.mesh.numNodes();
+    for (int i = 0; i < p.mesh.numNodes(); ++i) identity.node_old_to_new.push_back(i);
+    for (int t = 0; t < p.mesh.numTets(); ++t) identity.element_old_to_new.push_back(t);
+    std::vector<std::uint8_t> flags(p.model.fixed.begin(), p.model.fixed.end());
+    hysim::sim::CutUpdate3DOptions global;
+    global.mode_overlap = -1.0;
+    global.max_held_estimates = 0;
+    if (!hysim::sim::updateModelAfterCut3D(p.model, p.mesh, p.mesh, identity, flags, {}, global).ok()) return p;
+  }
   p.state = hysim::sim::makeState(p.model, p.mesh);
   p.ok = true;
   return p;

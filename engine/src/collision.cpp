@@ -2,6 +2,8 @@
 
 #include <fcl/math/bv/utility.h>  // fit(), which BVH_model-inl.h uses without including
 #include <fcl/geometry/bvh/BVH_model.h>
+#include <fcl/geometry/bvh/detail/BV_fitter_base.h>
+#include <fcl/geometry/bvh/detail/BV_splitter_base.h>
 #include <fcl/narrowphase/detail/traversal/collision_node.h>
 #include <fcl/narrowphase/detail/traversal/distance/mesh_distance_traversal_node.h>
 
@@ -68,6 +70,125 @@ void SweptWire::triangle(int t, Eigen::Vector3d& a, Eigen::Vector3d& b, Eigen::V
   b = bvh.vertices[tri[1]];
   c = bvh.vertices[tri[2]];
 }
+
+// ---------------------------------------------------------------------------------------
+// FCL's build of an AABB tree (BVHModel::endModel: fit the node's box, split at the mean of
+// its triangles' centroids along the box's longest axis, recurse) reads each triangle's three
+// vertices through FCL's generic fitter and splitter at every level. These two give the same
+// boxes and split rules (the same sums in the same order, so the same tree) from per-triangle
+// boxes and coordinate sums computed once when the build starts.
+class TriangleBoxes {
+ public:
+  void set(const fcl::Vector3d* vertices, const fcl::Triangle* tris, int num_tris) {
+    lo_.resize(static_cast<size_t>(num_tris));
+    hi_.resize(static_cast<size_t>(num_tris));
+    sum_.resize(static_cast<size_t>(num_tris));
+    for (int t = 0; t < num_tris; ++t) {
+      const fcl::Vector3d &a = vertices[tris[t][0]], &b = vertices[tris[t][1]], &c = vertices[tris[t][2]];
+      lo_[t] = a.cwiseMin(b).cwiseMin(c);
+      hi_[t] = a.cwiseMax(b).cwiseMax(c);
+      for (int k = 0; k < 3; ++k) sum_[t][k] = a[k] + b[k] + c[k];  // as FCL's mean rule adds them
+    }
+  }
+  void clear() {
+    lo_.clear();
+    hi_.clear();
+    sum_.clear();
+  }
+  std::vector<fcl::Vector3d> lo_, hi_, sum_;
+};
+
+class BoxFitter final : public fcl::detail::BVFitterBase<fcl::AABBd> {
+ public:
+  explicit BoxFitter(std::shared_ptr<TriangleBoxes> boxes) : boxes_(std::move(boxes)) {}
+  void set(fcl::Vector3d* vertices, fcl::Triangle* tris, fcl::BVHModelType type) override {
+    type_ = type;
+    vertices_ = vertices;
+    tris_ = tris;
+  }
+  void set(fcl::Vector3d* vertices, fcl::Vector3d* prev, fcl::Triangle* tris, fcl::BVHModelType type) override {
+    set(vertices, tris, type);
+    prev_ = prev;
+  }
+  fcl::AABBd fit(unsigned int* primitives, int count) override {
+    fcl::AABBd box;  // empty: +max / -max, as FCL's fitter starts
+    const TriangleBoxes& b = *boxes_;
+    if (type_ != fcl::BVH_MODEL_TRIANGLES || prev_ != nullptr || b.lo_.empty()) {
+      // Outside a build (FCL's top-down refit): FCL's own rule over the vertices.
+      for (int i = 0; i < count; ++i) {
+        const unsigned int p = primitives[i];
+        if (type_ == fcl::BVH_MODEL_TRIANGLES) {
+          for (int k = 0; k < 3; ++k) {
+            box += vertices_[tris_[p][k]];
+            if (prev_ != nullptr) box += prev_[tris_[p][k]];
+          }
+        } else {
+          box += vertices_[p];
+          if (prev_ != nullptr) box += prev_[p];
+        }
+      }
+      return box;
+    }
+    for (int i = 0; i < count; ++i) {
+      box.min_ = box.min_.cwiseMin(b.lo_[primitives[i]]);
+      box.max_ = box.max_.cwiseMax(b.hi_[primitives[i]]);
+    }
+    return box;
+  }
+  void clear() override {
+    vertices_ = nullptr;
+    prev_ = nullptr;
+    tris_ = nullptr;
+  }
+
+ private:
+  std::shared_ptr<TriangleBoxes> boxes_;
+  fcl::BVHModelType type_ = fcl::BVH_MODEL_UNKNOWN;
+  fcl::Vector3d* vertices_ = nullptr;
+  fcl::Vector3d* prev_ = nullptr;
+  fcl::Triangle* tris_ = nullptr;
+};
+
+class MeanSplitter final : public fcl::detail::BVSplitterBase<fcl::AABBd> {
+ public:
+  explicit MeanSplitter(std::shared_ptr<TriangleBoxes> boxes) : boxes_(std::move(boxes)) {}
+  void set(fcl::Vector3d* vertices, fcl::Triangle* tris, fcl::BVHModelType type) override {
+    type_ = type;
+    vertices_ = vertices;
+    if (type == fcl::BVH_MODEL_TRIANGLES) boxes_->set(vertices, tris, num_tris_);
+  }
+  void setNumTriangles(int n) { num_tris_ = n; }
+  void computeRule(const fcl::AABBd& bv, unsigned int* primitives, int count) override {
+    // FCL's SPLIT_METHOD_MEAN for AABB: the longest axis (x, then y on ties), the mean of
+    // the centroids' coordinates along it.
+    int axis = 2;
+    if (bv.width() >= bv.height() && bv.width() >= bv.depth()) {
+      axis = 0;
+    } else if (bv.height() >= bv.width() && bv.height() >= bv.depth()) {
+      axis = 1;
+    }
+    axis_ = axis;
+    double sum = 0;
+    if (type_ == fcl::BVH_MODEL_TRIANGLES) {
+      const std::vector<fcl::Vector3d>& s = boxes_->sum_;
+      for (int i = 0; i < count; ++i) sum += s[primitives[i]][axis];
+      sum /= 3;
+    } else {
+      for (int i = 0; i < count; ++i) sum += vertices_[primitives[i]][axis];
+    }
+    value_ = sum / count;
+  }
+  bool apply(const fcl::Vector3d& q) const override { return q[axis_] > value_; }
+  void clear() override { boxes_->clear(); }
+
+ private:
+  std::shared_ptr<TriangleBoxes> boxes_;
+  fcl::BVHModelType type_ = fcl::BVH_MODEL_UNKNOWN;
+  fcl::Vector3d* vertices_ = nullptr;
+  int num_tris_ = 0;
+  int axis_ = 0;
+  double value_ = 0.0;
+};
 
 // ---------------------------------------------------------------------------------------
 struct TissueCollision::Impl {
@@ -153,6 +274,13 @@ Status TissueCollision::build(const cutting::Tris& faces, const sim::NodeVectors
   std::vector<fcl::Vector3d> vertices(impl_->nodes.size());
   for (size_t i = 0; i < impl_->nodes.size(); ++i) vertices[i] = x.row(impl_->nodes[i]).transpose();
   auto bvh = std::make_shared<Bvh>();
+  {
+    auto boxes = std::make_shared<TriangleBoxes>();
+    auto splitter = std::make_shared<MeanSplitter>(boxes);
+    splitter->setNumTriangles(static_cast<int>(triangles.size()));
+    bvh->bv_splitter = splitter;
+    bvh->bv_fitter = std::make_shared<BoxFitter>(boxes);
+  }
   if (bvh->beginModel(static_cast<int>(triangles.size()), static_cast<int>(vertices.size())) != fcl::BVH_OK ||
       bvh->addSubModel(vertices, triangles) != fcl::BVH_OK || bvh->endModel() != fcl::BVH_OK) {
     impl_->nodes.clear();

@@ -56,6 +56,98 @@ bool matchFaces(const cutting::TetMesh& mesh, std::vector<int>& next) {
   return true;
 }
 
+bool updateFaces(const cutting::TetMesh& before, const std::vector<int>& next_before, const cutting::TetMesh& after,
+                 const std::vector<std::int32_t>& node_old_to_new, const std::vector<std::int32_t>& element_old_to_new,
+                 std::vector<int>& next) {
+  const int T0 = before.numTets(), T1 = after.numTets(), N0 = before.numNodes(), N1 = after.numNodes();
+  if (next_before.size() != 4 * static_cast<size_t>(T0) || element_old_to_new.size() != static_cast<size_t>(T0) ||
+      node_old_to_new.size() != static_cast<size_t>(N0)) {
+    return false;
+  }
+  for (int t = 0; t < T1; ++t)
+    for (int k = 0; k < 4; ++k)
+      if (after.T(t, k) < 0 || after.T(t, k) >= N1) return false;
+  // The old element of each new one, when it has the same nodes in the same order.
+  std::vector<int> old_of(static_cast<size_t>(T1), -1);
+  for (int t = 0; t < T0; ++t) {
+    const int u = element_old_to_new[t];
+    if (u < 0 || u >= T1) continue;
+    bool same = true;
+    for (int k = 0; k < 4 && same; ++k) {
+      const int i = before.T(t, k);
+      same = i >= 0 && i < N0 && node_old_to_new[i] == after.T(u, k);
+    }
+    if (same) old_of[u] = t;
+  }
+  std::vector<std::uint8_t> changed_node(static_cast<size_t>(N1), 0);
+  for (int u = 0; u < T1; ++u)
+    if (old_of[u] < 0)
+      for (int k = 0; k < 4; ++k) changed_node[after.T(u, k)] = 1;
+  std::vector<int> out(4 * static_cast<size_t>(T1), -1);
+  std::vector<int> open;  // slots to match among themselves
+  for (int u = 0; u < T1; ++u) {
+    const int o = old_of[u];
+    for (int f = 0; f < 4; ++f) {
+      const int s = 4 * u + f;
+      if (o < 0) {
+        open.push_back(s);
+        continue;
+      }
+      const int p = next_before[4 * static_cast<size_t>(o) + f];
+      if (p >= 0) {
+        const int u2 = p / 4 < T0 ? element_old_to_new[p / 4] : -1;
+        // Kept when both elements are kept as they were and the face had just the two.
+        if (u2 >= 0 && u2 < T1 && old_of[u2] == p / 4 && next_before[p] == 4 * o + f) {
+          out[s] = 4 * u2 + p % 4;
+        } else {
+          open.push_back(s);
+        }
+      } else {
+        const int* local = kTetFace[f];
+        if (changed_node[after.T(u, local[0])] || changed_node[after.T(u, local[1])] ||
+            changed_node[after.T(u, local[2])]) {
+          open.push_back(s);
+        }
+      }
+    }
+  }
+  struct Entry {
+    int a, b, c, slot;
+  };
+  std::vector<Entry> entries;
+  entries.reserve(open.size());
+  for (int s : open) {
+    const int t = s / 4;
+    const int* local = kTetFace[s % 4];
+    int a = after.T(t, local[0]), b = after.T(t, local[1]), c = after.T(t, local[2]);
+    if (a > b) std::swap(a, b);
+    if (b > c) std::swap(b, c);
+    if (a > b) std::swap(a, b);
+    entries.push_back({a, b, c, s});
+  }
+  std::sort(entries.begin(), entries.end(), [](const Entry& x, const Entry& y) {
+    if (x.a != y.a) return x.a < y.a;
+    if (x.b != y.b) return x.b < y.b;
+    if (x.c != y.c) return x.c < y.c;
+    return x.slot < y.slot;
+  });
+  for (size_t i = 0; i < entries.size();) {
+    size_t j = i + 1;
+    while (j < entries.size() && entries[j].a == entries[i].a && entries[j].b == entries[i].b &&
+           entries[j].c == entries[i].c) {
+      ++j;
+    }
+    if (j - i > 2) return false;  // a face of three elements: not a cut of a valid mesh
+    if (j - i == 2) {
+      out[entries[i].slot] = entries[i + 1].slot;
+      out[entries[i + 1].slot] = entries[i].slot;
+    }
+    i = j;
+  }
+  next = std::move(out);
+  return true;
+}
+
 Pieces tetPieces(const cutting::TetMesh& mesh, const std::vector<int>& next, const std::vector<std::uint8_t>& anchored) {
   const int M = mesh.numTets();
   std::vector<int> parent(static_cast<size_t>(M));

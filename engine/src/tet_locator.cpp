@@ -10,6 +10,7 @@ namespace hysim::engine {
 
 void TetLocator::build(const cutting::TetMesh& mesh, const sim::NodeVectors& x, double margin_mm) {
   margin_ = margin_mm;
+  max_box_ = 0.0;
   built_x_ = x;
   const int nt = mesh.numTets();
   dims_.setZero();
@@ -31,6 +32,8 @@ void TetLocator::build(const cutting::TetMesh& mesh, const sim::NodeVectors& x, 
   // unless the grid grew.
   std::vector<int>& count = cell_start_;
   count.assign(static_cast<size_t>(cells) + 1, 0);
+  // Each tet is listed in the cells its box (at the build, not grown) meets: a few cells per
+  // tet. A query grows its own point by how far the nodes may have moved since (locate()).
   auto cellRange = [&](int t, Eigen::Vector3i& a, Eigen::Vector3i& b) {
     Eigen::Vector3d tlo = x.row(mesh.T(t, 0)).transpose(), thi = tlo;
     for (int k = 1; k < 4; ++k) {
@@ -42,9 +45,10 @@ void TetLocator::build(const cutting::TetMesh& mesh, const sim::NodeVectors& x, 
       box[c] = tlo[c];
       box[3 + c] = thi[c];
     }
+    max_box_ = std::max(max_box_, (thi - tlo).maxCoeff());
     for (int c = 0; c < 3; ++c) {
-      a[c] = std::clamp(static_cast<int>(std::floor((tlo[c] - margin_ - origin_[c]) / cell_)), 0, dims_[c] - 1);
-      b[c] = std::clamp(static_cast<int>(std::floor((thi[c] + margin_ - origin_[c]) / cell_)), 0, dims_[c] - 1);
+      a[c] = std::clamp(static_cast<int>(std::floor((tlo[c] - origin_[c]) / cell_)), 0, dims_[c] - 1);
+      b[c] = std::clamp(static_cast<int>(std::floor((thi[c] - origin_[c]) / cell_)), 0, dims_[c] - 1);
     }
   };
   auto index = [&](int i, int j, int k) { return (static_cast<long>(k) * dims_.y() + j) * dims_.x() + i; };
@@ -76,42 +80,60 @@ int TetLocator::locate(const cutting::TetMesh& mesh, const sim::NodeVectors& x, 
                        double max_displacement) const {
   if (cell_start_.empty()) return -1;
   const double moved = max_displacement >= 0.0 ? max_displacement : margin_;
-  int ijk[3];
+  // A tet that holds p now had a build box within `moved` of p (plus the tolerances below,
+  // bounded by `slack`), so it is listed in a cell of the box around p grown by that.
+  const double slack = moved + 1e-6 * (max_box_ + 2.0 * moved) + 1e-9;
+  int lo[3], hi[3];
   for (int c = 0; c < 3; ++c) {
-    const int v = static_cast<int>(std::floor((p[c] - origin_[c]) / cell_));
-    if (v < 0 || v >= dims_[c]) return -1;
-    ijk[c] = v;
+    const double a = std::floor((p[c] - slack - origin_[c]) / cell_), b = std::floor((p[c] + slack - origin_[c]) / cell_);
+    if (b < 0.0 || a >= dims_[c]) return -1;
+    lo[c] = static_cast<int>(std::max(a, 0.0));
+    hi[c] = static_cast<int>(std::min(b, static_cast<double>(dims_[c] - 1)));
   }
-  const long cell = (static_cast<long>(ijk[2]) * dims_.y() + ijk[1]) * dims_.x() + ijk[0];
-  for (int e = cell_start_[cell]; e < cell_start_[cell + 1]; ++e) {
-    const int t = cell_tets_[e];
-    // The box at the build, grown by how far the nodes may have moved since and the test's
-    // tolerance below (for the largest box the tet can have now), holds the box below: a
-    // point outside it fails that test too, without reading the tet's nodes.
-    const double* box = &boxes_[6 * static_cast<size_t>(t)];
-    const double built = std::max({box[3] - box[0], box[4] - box[1], box[5] - box[2]});
-    const double grow = moved + 1e-6 * (built + 2.0 * moved) + 1e-9;
-    if (p[0] < box[0] - grow || p[1] < box[1] - grow || p[2] < box[2] - grow || p[0] > box[3] + grow ||
-        p[1] > box[4] + grow || p[2] > box[5] + grow) {
-      continue;
-    }
-    const Eigen::Vector3d a = x.row(mesh.T(t, 0)).transpose();
-    Eigen::Matrix3d m;
-    for (int k = 0; k < 3; ++k) m.col(k) = x.row(mesh.T(t, k + 1)).transpose() - a;
-    // A cell lists every tet whose box, grown by the margin, meets it (~170 in the uterus
-    // mesh): most are rejected by their box before the barycentric test. The box is grown by
-    // a millionth of its size, far more than the test's rounding (which would need a tet with
-    // a condition number ~1e9 to accept a point that much outside it).
-    const Eigen::Array3d lo = m.rowwise().minCoeff().array().min(0.0) + a.array();
-    const Eigen::Array3d hi = m.rowwise().maxCoeff().array().max(0.0) + a.array();
-    const double tol = 1e-6 * (hi - lo).maxCoeff();
-    if ((p.array() < lo - tol).any() || (p.array() > hi + tol).any()) continue;
-    const double det = m.determinant();
-    if (std::abs(det) < 1e-300) continue;
-    const Eigen::Vector3d w = m.inverse() * (p - a);  // barycentric coordinates of nodes 1..3
-    if (w.minCoeff() >= 0.0 && w.sum() <= 1.0) return t;
+  // The lowest-numbered tet that holds p (a point on a shared face lies in several): the
+  // same answer whichever cells list it.
+  int best = -1;
+  for (int k = lo[2]; k <= hi[2]; ++k)
+    for (int j = lo[1]; j <= hi[1]; ++j)
+      for (int i = lo[0]; i <= hi[0]; ++i) {
+        const long cell = (static_cast<long>(k) * dims_.y() + j) * dims_.x() + i;
+        for (int e = cell_start_[cell]; e < cell_start_[cell + 1]; ++e) {
+          const int t = cell_tets_[e];
+          if (best >= 0 && t >= best) break;  // a cell lists its tets in increasing order
+          if (contains(mesh, x, t, p, moved)) {
+            best = t;
+            break;
+          }
+        }
+      }
+  return best;
+}
+
+bool TetLocator::contains(const cutting::TetMesh& mesh, const sim::NodeVectors& x, int t, const Eigen::Vector3d& p,
+                          double moved) const {
+  // The box at the build, grown by how far the nodes may have moved since and the test's
+  // tolerance below (for the largest box the tet can have now), holds the box below: a
+  // point outside it fails that test too, without reading the tet's nodes.
+  const double* box = &boxes_[6 * static_cast<size_t>(t)];
+  const double built = std::max({box[3] - box[0], box[4] - box[1], box[5] - box[2]});
+  const double grow = moved + 1e-6 * (built + 2.0 * moved) + 1e-9;
+  if (p[0] < box[0] - grow || p[1] < box[1] - grow || p[2] < box[2] - grow || p[0] > box[3] + grow ||
+      p[1] > box[4] + grow || p[2] > box[5] + grow) {
+    return false;
   }
-  return -1;
+  const Eigen::Vector3d a = x.row(mesh.T(t, 0)).transpose();
+  Eigen::Matrix3d m;
+  for (int k = 0; k < 3; ++k) m.col(k) = x.row(mesh.T(t, k + 1)).transpose() - a;
+  // The box is grown by a millionth of its size, far more than the test's rounding (which
+  // would need a tet with a condition number ~1e9 to accept a point that much outside it).
+  const Eigen::Array3d lo = m.rowwise().minCoeff().array().min(0.0) + a.array();
+  const Eigen::Array3d hi = m.rowwise().maxCoeff().array().max(0.0) + a.array();
+  const double tol = 1e-6 * (hi - lo).maxCoeff();
+  if ((p.array() < lo - tol).any() || (p.array() > hi + tol).any()) return false;
+  const double det = m.determinant();
+  if (std::abs(det) < 1e-300) return false;
+  const Eigen::Vector3d w = m.inverse() * (p - a);  // barycentric coordinates of nodes 1..3
+  return w.minCoeff() >= 0.0 && w.sum() <= 1.0;
 }
 
 double TetLocator::maxDisplacement(const sim::NodeVectors& x) const {

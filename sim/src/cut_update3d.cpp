@@ -53,32 +53,44 @@ double topEigenvalue(const Model& m, const cutting::Positions& X, const std::vec
     }
   }
   const Eigen::Index n3 = 3 * static_cast<Eigen::Index>(count);
+  // Structure of arrays, a held end pointing at a zero slot past the free ones (its scale
+  // is 0 and its row of the result is dropped): no branches, the same arithmetic as with
+  // them (0 * 0 added or subtracted leaves a value as it is).
+  const size_t ns = springs.size();
+  std::vector<int> ia(ns), ib(ns);
+  std::vector<double> sdx(ns), sdy(ns), sdz(ns), sk(ns), ssa(ns), ssb(ns);
+  for (size_t i = 0; i < ns; ++i) {
+    const LocalSpring& ls = springs[i];
+    ia[i] = 3 * (ls.a >= 0 ? ls.a : count);
+    ib[i] = 3 * (ls.b >= 0 ? ls.b : count);
+    sdx[i] = ls.dx;
+    sdy[i] = ls.dy;
+    sdz[i] = ls.dz;
+    sk[i] = ls.k;
+    ssa[i] = ls.sa;
+    ssb[i] = ls.sb;
+  }
+  Eigen::VectorXd u_pad = Eigen::VectorXd::Zero(n3 + 3), z_pad(n3 + 3);
   auto apply = [&](const Eigen::VectorXd& u, Eigen::VectorXd& z) {
-    z.setZero();
-    for (const LocalSpring& s : springs) {
-      double yx = 0, yy = 0, yz = 0;
-      if (s.b >= 0) {
-        yx += s.sb * u[3 * s.b];
-        yy += s.sb * u[3 * s.b + 1];
-        yz += s.sb * u[3 * s.b + 2];
-      }
-      if (s.a >= 0) {
-        yx -= s.sa * u[3 * s.a];
-        yy -= s.sa * u[3 * s.a + 1];
-        yz -= s.sa * u[3 * s.a + 2];
-      }
-      const double t = s.k * (yx * s.dx + yy * s.dy + yz * s.dz);  // (K y)_b = t d, (K y)_a = -t d
-      if (s.a >= 0) {
-        z[3 * s.a] -= s.sa * t * s.dx;
-        z[3 * s.a + 1] -= s.sa * t * s.dy;
-        z[3 * s.a + 2] -= s.sa * t * s.dz;
-      }
-      if (s.b >= 0) {
-        z[3 * s.b] += s.sb * t * s.dx;
-        z[3 * s.b + 1] += s.sb * t * s.dy;
-        z[3 * s.b + 2] += s.sb * t * s.dz;
-      }
+    u_pad.head(n3) = u;
+    z_pad.setZero();
+    const double* up = u_pad.data();
+    double* zp = z_pad.data();
+    for (size_t i = 0; i < ns; ++i) {
+      const int a = ia[i], b = ib[i];
+      const double sa = ssa[i], sb = ssb[i], dx = sdx[i], dy = sdy[i], dz = sdz[i];
+      const double yx = sb * up[b] - sa * up[a];
+      const double yy = sb * up[b + 1] - sa * up[a + 1];
+      const double yz = sb * up[b + 2] - sa * up[a + 2];
+      const double t = sk[i] * (yx * dx + yy * dy + yz * dz);  // (K y)_b = t d, (K y)_a = -t d
+      zp[a] -= sa * t * dx;
+      zp[a + 1] -= sa * t * dy;
+      zp[a + 2] -= sa * t * dz;
+      zp[b] += sb * t * dx;
+      zp[b + 1] += sb * t * dy;
+      zp[b + 2] += sb * t * dz;
     }
+    z = z_pad.head(n3);
   };
   // Start: the alternating pattern of buildModel's power iteration (excites the highest
   // modes), plus the given vector.
@@ -99,7 +111,7 @@ double topEigenvalue(const Model& m, const cutting::Positions& X, const std::vec
     q.normalize();
   }
   const int max_steps = std::max(1, std::min(options.lanczos_steps, static_cast<int>(n3)));
-  const bool reorthogonalise = n3 <= 30000;  // cheap near a cut; not worth it over a whole mesh
+  const bool reorthogonalise = n3 <= 3000;  // cheap near a small cut; not worth it over many nodes
   Eigen::MatrixXd Q(n3, max_steps);
   std::vector<double> alpha, beta, history;
   Eigen::VectorXd z(n3);
@@ -166,9 +178,14 @@ Status updateModelAfterCut3D(Model& model, const cutting::TetMesh& before, const
 
   // Material of each tet.
   std::vector<int> material(static_cast<size_t>(T1), -1);
-  for (int t = 0; t < T1; ++t) {
-    for (int i = 0; i < static_cast<int>(model.materials.size()); ++i)
-      if (model.materials[i].label == after.material[t]) material[t] = i;
+  for (int t = 0, last_label = 0, last = -1; t < T1; ++t) {
+    if (last < 0 || after.material[t] != last_label) {  // runs of one label: look up at changes
+      last_label = after.material[t];
+      last = -1;
+      for (int i = 0; i < static_cast<int>(model.materials.size()); ++i)
+        if (model.materials[i].label == last_label) last = i;  // the last with the label, as before
+    }
+    material[t] = last;
     if (material[t] < 0)
       return Error{"tet " + std::to_string(t) + " has material label " + std::to_string(after.material[t]) +
                    " but the scene defines no material with that label"};
@@ -225,9 +242,11 @@ Status updateModelAfterCut3D(Model& model, const cutting::TetMesh& before, const
         a[k] = after.T(t, k);
         b[k] = o2n[before.T(o, k)];
       }
-      std::sort(a.begin(), a.end());
-      std::sort(b.begin(), b.end());
-      same = a == b;
+      if (a != b) {  // the same nodes in another order are the same element
+        std::sort(a.begin(), a.end());
+        std::sort(b.begin(), b.end());
+        same = a == b;
+      }
     }
     if (!same) {
       touchTet(t);
@@ -320,33 +339,61 @@ Status updateModelAfterCut3D(Model& model, const cutting::TetMesh& before, const
     if (a < 0 || b < 0 || (touched[a] && touched[b])) continue;
     springs.push_back({a, b, model.rest_length[s], model.stiffness[s], model.damping[s]});
   }
-  std::vector<std::int64_t> keys;
-  for (int a : region_nodes) {
-    if (!touched[a]) continue;
-    for (int e = off[a]; e < off[a + 1]; ++e)
-      for (int k = 0; k < 4; ++k) {
-        const int b = after.T(around[e], k);
-        if (b > a && touched[b]) keys.push_back(static_cast<std::int64_t>(a) * N1 + b);
+  // Each (tet, edge) with both ends touched, bucketed by the edge's smaller node in
+  // increasing tet order, then each bucket sorted by the larger node (stably: an edge's tets
+  // stay in increasing order, the order buildModel sums them in).
+  struct EdgeOfTet {
+    int b, tet;
+  };
+  constexpr int kTetEdges[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
+  std::vector<int> edge_tets_of;
+  for (int t = 0; t < T1; ++t) {
+    const int n0 = after.T(t, 0), n1 = after.T(t, 1), n2 = after.T(t, 2), n3 = after.T(t, 3);
+    if (touched[n0] + touched[n1] + touched[n2] + touched[n3] >= 2) edge_tets_of.push_back(t);
+  }
+  std::vector<int> bucket(static_cast<size_t>(N1) + 1, 0);
+  auto forTouchedEdges = [&](auto&& f) {
+    for (int t : edge_tets_of)
+      for (const auto& e : kTetEdges) {
+        const int a = after.T(t, e[0]), b = after.T(t, e[1]);
+        if (touched[a] && touched[b]) f(t, std::min(a, b), std::max(a, b));
       }
+  };
+  forTouchedEdges([&](int, int a, int) { ++bucket[a + 1]; });
+  for (int i = 0; i < N1; ++i) bucket[i + 1] += bucket[i];
+  std::vector<EdgeOfTet> edge_tets(static_cast<size_t>(bucket[N1]));
+  {
+    std::vector<int> fill(bucket.begin(), bucket.end() - 1);
+    forTouchedEdges([&](int t, int a, int b) { edge_tets[fill[a]++] = {b, t}; });
   }
-  std::sort(keys.begin(), keys.end());
-  keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
-  for (std::int64_t key : keys) {
-    const int a = static_cast<int>(key / N1), b = static_cast<int>(key % N1);
-    double ev = 0.0, bev = 0.0;
-    for (int e = off[a]; e < off[a + 1]; ++e) {
-      const int t = around[e];
-      if (after.T(t, 0) != b && after.T(t, 1) != b && after.T(t, 2) != b && after.T(t, 3) != b) continue;
-      const double vol = tetVolume(t);
-      if (!(vol > 0.0)) return Error{"tet " + std::to_string(t) + " has non-positive volume " + std::to_string(vol)};
-      const Material& mat = model.materials[material[t]];
-      ev += mat.young_modulus_pa * vol;
-      bev += mat.stiffness_damping_s * mat.young_modulus_pa * vol;
+  for (int a = 0; a < N1; ++a) {
+    EdgeOfTet* const first = edge_tets.data() + bucket[a];
+    EdgeOfTet* const last = edge_tets.data() + bucket[a + 1];
+    for (EdgeOfTet* i = first + 1; i < last; ++i) {  // insertion sort: a few dozen entries
+      const EdgeOfTet e = *i;
+      EdgeOfTet* j = i;
+      for (; j > first && j[-1].b > e.b; --j) *j = j[-1];
+      *j = e;
     }
-    const double len = (after.X.row(b) - after.X.row(a)).norm();
-    springs.push_back({a, b, len, ev / (len * len), bev / (len * len)});
   }
-  rep.springs_recomputed = static_cast<int>(keys.size());
+  int recomputed = 0;
+  for (int a = 0; a < N1; ++a)
+    for (int i = bucket[a]; i < bucket[a + 1];) {
+      const int b = edge_tets[i].b;
+      double ev = 0.0, bev = 0.0;
+      for (; i < bucket[a + 1] && edge_tets[i].b == b; ++i) {
+        const int t = edge_tets[i].tet;
+        const double vol = tetVolume(t);
+        if (!(vol > 0.0)) return Error{"tet " + std::to_string(t) + " has non-positive volume " + std::to_string(vol)};
+        const Material& mat = model.materials[material[t]];
+        ev += mat.young_modulus_pa * vol;
+        bev += mat.stiffness_damping_s * mat.young_modulus_pa * vol;
+      }
+      const double len = (after.X.row(b) - after.X.row(a)).norm();
+      springs.push_back({a, b, len, ev / (len * len), bev / (len * len)});
+      ++recomputed;
+    }
+  rep.springs_recomputed = recomputed;
 
   // Pieces cut free leave; the rest is renumbered (order kept).
   std::vector<std::int32_t> keep(node_to_kept);
@@ -418,11 +465,17 @@ Status updateModelAfterCut3D(Model& model, const cutting::TetMesh& before, const
   auto substepsFor = [&](double critical) {
     return std::max(1, static_cast<int>(std::ceil(opt.dt / (opt.stability_safety * critical))));
   };
-  rep.global_stability = overlap > options.mode_overlap || !(rep.omega_previous > 0.0);
+  // The previous mode near the cut: its estimate is held as a bound for the rest (see
+  // tissue_update3d.hpp), for at most max_held_estimates updates in a row.
+  const bool mode_near_cut = overlap > options.mode_overlap;
+  const int held_before = m.stability_held;
+  const bool can_hold = held_before >= 0 && held_before < options.max_held_estimates;
+  rep.global_stability = !(rep.omega_previous > 0.0) || (mode_near_cut && !can_hold);
   std::vector<int> estimate_nodes;
   for (int i = 0; i < N2; ++i)
     if (!m.fixed[i] && (rep.global_stability || near[i])) estimate_nodes.push_back(i);
   rep.stability_nodes = static_cast<int>(estimate_nodes.size());
+  bool carried = false;  // omega_max is the previous estimate (scaling near the cut cannot lower it)
   auto estimate = [&]() {
     Eigen::MatrixX3d ritz;
     int steps = 0;
@@ -431,20 +484,29 @@ Status updateModelAfterCut3D(Model& model, const cutting::TetMesh& before, const
     rep.lanczos_steps += steps;
     rep.omega_local = std::sqrt(lambda);
     if (rep.global_stability || rep.omega_local >= rep.omega_previous) {
+      // A Lanczos estimate of its own (near the cut it is above every bound carried over).
       m.omega_max = rep.omega_local;
       m.stability_mode = std::move(ritz);
+      // The rest of the mesh stays bounded by the previous estimate if that was one.
+      m.stability_held = rep.global_stability || held_before >= 0 ? 0 : -1;
+      rep.held_stability = false;
+      carried = false;
     } else {
       m.omega_max = rep.omega_previous;
       m.stability_mode = mapped_mode;
+      m.stability_held = mode_near_cut && held_before >= 0 ? held_before + 1 : held_before;
+      rep.held_stability = mode_near_cut;
+      carried = true;
     }
     m.critical_dt = stabilityLimit(m.omega_max);
   };
   estimate();
   // Selective mass scaling, as buildModel, on the nodes of the estimate.
-  if (opt.substeps <= 0 && opt.max_substeps > 0 && substepsFor(m.critical_dt) > opt.max_substeps) {
+  // A carried-over previous estimate is not lowered by mass near the cut: no rounds then.
+  if (opt.substeps <= 0 && opt.max_substeps > 0 && substepsFor(m.critical_dt) > opt.max_substeps && !carried) {
     const StepSprings& st = m.step_springs;
     double target = 0.8 * 2.0 * opt.stability_safety * opt.max_substeps / opt.dt;
-    for (int round = 0; round < 4 && substepsFor(m.critical_dt) > opt.max_substeps; ++round) {
+    for (int round = 0; round < 4 && substepsFor(m.critical_dt) > opt.max_substeps && !carried; ++round) {
       for (int i : estimate_nodes) {
         double k_sum = 0.0;
         for (int e = st.node_offset[i]; e < st.node_offset[i + 1]; ++e) k_sum += st.stiffness[st.incident[e]];

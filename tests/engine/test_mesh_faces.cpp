@@ -68,6 +68,50 @@ TEST(MeshFaces, SameAsCuttingOnTheUterus) {
   expectSameAsCutting(*mesh);
 }
 
+// updateFaces after a sequence of cuts (through, partial, hybrid and standard, on the uterus
+// and a box) gives exactly matchFaces' next of the cut mesh, and refuses mismatched input.
+TEST(MeshFaces, UpdateAfterCutsMatchesMatchingAllFaces) {
+  auto uterus = cutting::readTetMesh(std::string(HYSIM_SOURCE_DIR) + "/assets/uterus_myoma.msh");
+  ASSERT_TRUE(uterus.ok()) << uterus.error();
+  for (const cutting::TetMesh& start : {testing::boxTetMesh(5, 5, 5, 0.4), *uterus}) {
+    cutting::TetMesh mesh = start;
+    std::vector<int> next;
+    ASSERT_TRUE(matchFaces(mesh, next));
+    const Vec3 lo = mesh.X.colwise().minCoeff().transpose(), hi = mesh.X.colwise().maxCoeff().transpose();
+    for (int cut = 0; cut < 4; ++cut) {
+      const Vec3 c = lo + (hi - lo).cwiseProduct(Vec3(0.31 + 0.11 * cut, 0.47, 0.29 + 0.13 * cut));
+      const Vec3 d = (hi - lo) * 0.3;
+      // A quad that ends inside the mesh (partial) for odd cuts, a plane for even ones.
+      Result<cutting::CutSurface> surface = cutting::CutSurface::plane(c, Vec3(0.2 * cut, 0.1, 1.0).normalized());
+      if (cut % 2 == 1) {
+        cutting::Positions v(4, 3);
+        v << c.x() - 3 * d.x(), c.y() - 3 * d.y(), c.z(), c.x() + d.x(), c.y() - 3 * d.y(), c.z() + 0.01 * d.z(),
+            c.x() - 3 * d.x(), c.y() + d.y(), c.z() + 0.02 * d.z(), c.x() + d.x(), c.y() + d.y(), c.z();
+        cutting::Tris f(2, 3);
+        f << 0, 1, 3, 0, 3, 2;
+        surface = cutting::CutSurface::triangles(v, f);
+      }
+      ASSERT_TRUE(surface.ok());
+      cutting::Cut3DOptions options;
+      options.method = cut < 2 ? cutting::CutMethod::Hybrid : cutting::CutMethod::Standard;
+      auto r = cutting::cut3d(mesh, *surface, options);
+      ASSERT_TRUE(r.ok()) << r.error();
+      std::vector<int> updated, expected;
+      ASSERT_TRUE(updateFaces(mesh, next, r->mesh, r->change.node_old_to_new, r->change.element_old_to_new, updated))
+          << "cut " << cut;
+      ASSERT_TRUE(matchFaces(r->mesh, expected));
+      EXPECT_EQ(updated, expected) << "cut " << cut;
+      // Wrong sizes: refused, output untouched.
+      std::vector<int> untouched{3};
+      EXPECT_FALSE(updateFaces(mesh, std::vector<int>(5, -1), r->mesh, r->change.node_old_to_new,
+                               r->change.element_old_to_new, untouched));
+      EXPECT_EQ(untouched, std::vector<int>{3});
+      mesh = r->mesh;
+      next = expected;
+    }
+  }
+}
+
 TEST(MeshFaces, AFaceSharedByThreeTetsJoinsThemAll) {
   // Not a valid mesh, but cutting::tetComponents joins all the tets of a face: so must this.
   cutting::TetMesh m;

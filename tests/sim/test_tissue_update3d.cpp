@@ -186,6 +186,7 @@ TEST(TissueUpdate3D, IncrementalUpdateMatchesARebuild) {
       std::vector<std::uint8_t> flags(model.fixed.begin(), model.fixed.end());
       CutUpdate3DOptions options;
       options.mode_overlap = -1.0;
+      options.max_held_estimates = 0;  // never the previous estimate held as a bound
       ASSERT_TRUE(updateModelAfterCut3D(global, kept, kept, identity, flags, {}, options).ok());
       EXPECT_GT(model.omega_max, 0.97 * global.omega_max) << "cut " << cut << (report.global_stability ? " global" : " local");
     }
@@ -231,6 +232,83 @@ TEST(TissueUpdate3D, IncrementalUpdateAfterAPartialCut) {
   EXPECT_NEAR(model.mass.sum(), built->mass.sum(), 1e-9 * built->mass.sum());
 }
 
+// Global Lanczos estimate of `model` as it is (nothing changed, every node's mode "near").
+double globalOmega(const Model& model, const cutting::TetMesh& mesh) {
+  Model global = model;
+  cutting::TopologyChange identity;
+  identity.old_num_nodes = identity.new_num_nodes = mesh.numNodes();
+  for (int i = 0; i < mesh.numNodes(); ++i) identity.node_old_to_new.push_back(i);
+  for (int t = 0; t < mesh.numTets(); ++t) identity.element_old_to_new.push_back(t);
+  std::vector<std::uint8_t> flags(model.fixed.begin(), model.fixed.end());
+  CutUpdate3DOptions options;
+  options.mode_overlap = -1.0;
+  options.max_held_estimates = 0;
+  CutUpdate3DReport report;
+  EXPECT_TRUE(updateModelAfterCut3D(global, mesh, mesh, identity, flags, {}, options, &report).ok());
+  EXPECT_TRUE(report.global_stability);
+  return global.omega_max;
+}
+
+// Cuts near the previous highest mode: the previous estimate is held as a bound for the
+// rest of the mesh (never below the global estimate of the cut model), at most
+// max_held_estimates updates in a row; the first update after buildModel (power iteration)
+// and the one after that many holds estimate over all nodes. With max_held_estimates = 0
+// every such update is global.
+TEST(TissueUpdate3D, HeldStabilityBoundStaysAboveTheGlobalEstimate) {
+  for (const int max_held : {2, 0}) {
+    cutting::TetMesh mesh = testing::boxTetMesh(6, 6, 6, 1.0);
+    Material mat;
+    mat.label = 1;
+    std::vector<int> fixed;
+    for (int i = 0; i < mesh.numNodes(); ++i)
+      if (mesh.X(i, 2) < 0.5) fixed.push_back(i);
+    auto built = buildModel(mesh, {mat}, fixed, {});
+    ASSERT_TRUE(built.ok());
+    Model model = *built;
+    EXPECT_EQ(model.stability_held, -1);
+    CutUpdate3DOptions options;
+    options.mode_overlap = -1.0;  // every cut counts as near the previous mode
+    options.max_held_estimates = max_held;
+    int holds = 0, globals = 0, held_in_a_row = 0;
+    for (int cut = 0; cut < 8; ++cut) {
+      const Vec3 point(1.3 + 0.45 * cut, 2.9, 3.1), normal(1.0, 0.1 * (cut % 3), 0.2);
+      auto r = cutting::cut3d(mesh, *cutting::CutSurface::plane(point, normal));
+      ASSERT_TRUE(r.ok()) << r.error();
+      std::vector<std::uint8_t> flags(static_cast<size_t>(r->mesh.numNodes()), 0);
+      for (int i = 0; i < r->mesh.numNodes(); ++i) flags[i] = r->mesh.X(i, 2) < 0.5 ? 1 : 0;
+      const int held_before = model.stability_held;
+      CutUpdate3DReport report;
+      ASSERT_TRUE(updateModelAfterCut3D(model, mesh, r->mesh, r->change, flags, {}, options, &report).ok());
+      mesh = r->mesh;
+      const bool must_be_global = held_before < 0 || held_before >= max_held;
+      EXPECT_EQ(report.global_stability, must_be_global) << "cut " << cut << " held before " << held_before;
+      EXPECT_FALSE(report.global_stability && report.held_stability);
+      if (report.held_stability) {
+        EXPECT_EQ(model.omega_max, report.omega_previous);
+        EXPECT_LT(report.omega_local, report.omega_previous);
+        EXPECT_EQ(model.stability_held, held_before + 1);
+      } else {
+        EXPECT_EQ(model.stability_held, 0);
+      }
+      held_in_a_row = report.held_stability ? held_in_a_row + 1 : 0;
+      EXPECT_LE(held_in_a_row, max_held);
+      holds += report.held_stability ? 1 : 0;
+      globals += report.global_stability ? 1 : 0;
+      // The held bound, like the local estimate, is not below the whole mesh's estimate.
+      const double global = globalOmega(model, mesh);
+      EXPECT_GT(model.omega_max, 0.97 * global) << "cut " << cut;
+      EXPECT_EQ(model.critical_dt > 0.0, true);
+    }
+    if (max_held > 0) {
+      EXPECT_GT(holds, 0);
+      EXPECT_LT(globals, 8);
+    } else {
+      EXPECT_EQ(holds, 0);
+      EXPECT_EQ(globals, 8);
+    }
+  }
+}
+
 // The Lanczos estimate over the whole mesh is at least the power iteration's (no change:
 // an empty cut keeps every node; the overlap threshold < 0 forces the global estimate).
 TEST(TissueUpdate3D, LanczosEstimateReachesThePowerIteration) {
@@ -252,6 +330,7 @@ TEST(TissueUpdate3D, LanczosEstimateReachesThePowerIteration) {
   for (int i : fixed) flags[i] = 1;
   CutUpdate3DOptions options;
   options.mode_overlap = -1.0;
+  options.max_held_estimates = 0;
   CutUpdate3DReport report;
   ASSERT_TRUE(updateModelAfterCut3D(model, mesh, mesh, identity, flags, {}, options, &report).ok());
   EXPECT_TRUE(report.global_stability);

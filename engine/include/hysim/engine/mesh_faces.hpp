@@ -24,6 +24,18 @@ inline constexpr int kTetFace[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1
 // outside [0, #N), which a valid mesh never has.
 bool matchFaces(const cutting::TetMesh& mesh, std::vector<int>& next);
 
+// matchFaces' next for `after`, a cut of `before` (change: the cut's TopologyChange), from
+// next_before (matchFaces' next of before) instead of from all faces: a slot of an element
+// that the cut kept with the same nodes in the same order keeps its neighbour when that one
+// was kept so too, and stays on the boundary when it was there and no node of its face
+// belongs to a changed element; the other slots (the changed elements', and those next to
+// them) are matched among themselves. Linear in #T with a small constant, sorting only the
+// slots near the cut. Returns false (next untouched) when it cannot tell: sizes that do not
+// match, a face of more than two elements, node ids out of range; matchFaces then.
+bool updateFaces(const cutting::TetMesh& before, const std::vector<int>& next_before, const cutting::TetMesh& after,
+                 const std::vector<std::int32_t>& node_old_to_new, const std::vector<std::int32_t>& element_old_to_new,
+                 std::vector<int>& next);
+
 // Connected components through shared faces, numbered in the order of their first tet, and
 // whether each touches no anchored node: cutting::tetComponents' label, count and free (not
 // its volumes), from matchFaces' next.

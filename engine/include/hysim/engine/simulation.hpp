@@ -186,6 +186,7 @@ class Simulation {
   std::vector<std::uint8_t> on_cut_;  // #N: node lies on a cut surface (drawn as cut tissue)
   std::vector<std::uint8_t> anchored_;  // #N: rest position in an anchor region (fixed)
   std::vector<double> tet_quality_;     // #T: q* of each element (rest shape), for q_min
+  std::vector<int> face_next_;          // 4 #T: matchFaces' next of mesh_ (empty: unknown)
   double initial_myoma_mm3_ = 0.0;
   double electrode_active_s_ = 0.0;
   double path_length_mm_ = 0.0;

@@ -1,8 +1,9 @@
 #pragma once
 // Which tet contains a point, for the loop electrode's "is the wire in the tissue" test.
-// A uniform grid over the tets' bounding boxes, built with a margin; queries use the
-// current node positions, so the grid stays valid while no node has moved further than the
-// margin since the build (the caller rebuilds when one has, and after topology changes).
+// A uniform grid over the tets' bounding boxes at the build; queries use the current node
+// positions and look in the cells within the nodes' displacement since the build, so the grid
+// stays valid however far they moved; the caller rebuilds when one has moved further than
+// the margin (queries get slower with the displacement) and after topology changes.
 //
 // The step uses it only for the wire's "buried" case, once per contact-free stretch: contact
 // with the tissue's surface is FCL's job (collision.hpp).
@@ -27,6 +28,10 @@ class TetLocator {
   double margin() const { return margin_; }
 
  private:
+  // p lies in tet t at positions x, the nodes having moved at most `moved` since the build.
+  bool contains(const cutting::TetMesh& mesh, const sim::NodeVectors& x, int t, const Eigen::Vector3d& p,
+                double moved) const;
+
   Eigen::Vector3d origin_{0, 0, 0};
   double cell_ = 1.0;
   Eigen::Vector3i dims_{0, 0, 0};
@@ -37,6 +42,7 @@ class TetLocator {
   std::vector<double> boxes_;            // 6 #T: each tet's box at the build (min xyz, max xyz)
   sim::NodeVectors built_x_;
   double margin_ = 1.0;
+  double max_box_ = 0.0;                 // largest extent of a tet's box at the build
 };
 
 }  // namespace hysim::engine

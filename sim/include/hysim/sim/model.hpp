@@ -86,6 +86,11 @@ struct Model {
   // norm, zero at fixed nodes). A cut that leaves it alone leaves omega_max valid away from
   // the cut, so the incremental update (updateModelAfterCut3D) only estimates near the cut.
   Eigen::MatrixX3d stability_mode;
+  // Updates since omega_max was last a Lanczos estimate over all free nodes in which it is a
+  // previous estimate held as a bound (its mode was near a cut; see updateModelAfterCut3D).
+  // -1: no such estimate yet (buildModel's power iteration approaches omega_max from below,
+  // too far to serve as a bound).
+  int stability_held = -1;
 
   std::shared_ptr<const ImplicitSolver> implicit;  // set when integrator == ImplicitEuler
 };

@@ -75,8 +75,19 @@ Result<Model> updateModel3D(const Model& before, const cutting::TetMesh& mesh_be
 //    the cut (the springs to nodes outside held fixed: a principal submatrix, whose top
 //    eigenvalue is a lower bound of the whole mesh's, like the power iteration's estimate),
 //    combined with the previous omega_max when the previous highest mode (stability_mode)
-//    lies away from the cut; otherwise a Lanczos estimate over all free nodes, started from
-//    that mode. Selective mass scaling as buildModel, on the nodes near the cut.
+//    lies away from the cut. When that mode lies near the cut, the previous omega_max is
+//    still a bound for the rest of the mesh: the free nodes away from the cut (their springs
+//    and masses unchanged) form a principal submatrix of the previous matrix too, whose top
+//    eigenvalue is at most the previous one (Cauchy interlacing), so max(estimate near the
+//    cut, previous omega_max) is not below what the whole mesh's estimate would find away
+//    from the cut, only possibly above it (the mode that set it may have been cut away).
+//    That held bound decides omega_max for at most max_held_estimates updates in a row (an
+//    estimate near the cut at or above it ends the run: it is then at least the rest's
+//    bound, about what an estimate over all nodes would find); then, and
+//    when the previous estimate is not a Lanczos one (buildModel's power iteration, which
+//    approaches the top from below, too far to bound anything), a Lanczos estimate over all
+//    free nodes, started from the previous mode, replaces it. Selective mass scaling as buildModel, on the
+//    nodes of the estimate.
 //  - the implicit integrator's factorisation is redone.
 struct CutUpdate3DOptions {
   MassUpdate3DOptions masses;
@@ -85,6 +96,9 @@ struct CutUpdate3DOptions {
   int lanczos_steps = 60;           // at most
   int lanczos_min_steps = 20;       // at least (when the space is that large)
   double lanczos_tolerance = 1e-3;  // relative residual of the top Ritz pair, and its growth over 5 steps
+  // Updates in a row whose omega_max may be the previous one held as a bound after its
+  // mode was near the cut (Model::stability_held); 0 = estimate over all nodes instead.
+  int max_held_estimates = 4;
 };
 
 struct CutUpdate3DReport {
@@ -93,7 +107,8 @@ struct CutUpdate3DReport {
   int springs_recomputed = 0;     // edges between touched nodes, recomputed
   int stability_nodes = 0;        // free nodes of the frequency estimate
   int lanczos_steps = 0;
-  bool global_stability = false;  // the previous mode was near the cut: estimated over all nodes
+  bool global_stability = false;  // estimated over all free nodes (no previous estimate, or held too long)
+  bool held_stability = false;    // the previous mode was near the cut: omega_max = max(local, previous)
   double omega_local = 0.0;       // rad/s, estimate near the cut
   double omega_previous = 0.0;    // rad/s
 };
