@@ -7,6 +7,7 @@
 #include <cmath>
 #include <limits>
 #include <numeric>
+#include <span>
 #include <string>
 #include <unordered_map>
 #include <unordered_set>
@@ -41,6 +42,70 @@ struct FaceKeyHash {
     return static_cast<size_t>(h);
   }
 };
+// Open-addressing hash map (linear probing, power-of-two capacity) for the small maps of a
+// cut: crossed edges, faces on the cut. Much cheaper than std::unordered_map (no node per
+// entry); lookups only, so its layout never affects the results. `empty` is a key no entry
+// uses.
+template <class Key, class Value, class Hash>
+class FlatMap {
+ public:
+  explicit FlatMap(Key empty) : empty_(empty) { rehash(64); }
+  size_t size() const { return size_; }
+  Value* find(const Key& k) {
+    for (size_t i = Hash{}(k) & mask_;; i = (i + 1) & mask_) {
+      if (keys_[i] == k) return &vals_[i];
+      if (keys_[i] == empty_) return nullptr;
+    }
+  }
+  bool contains(const Key& k) { return find(k) != nullptr; }
+  // The value for k, inserting `v` if absent; second: whether it was inserted.
+  std::pair<Value*, bool> tryEmplace(const Key& k, const Value& v) {
+    if (2 * (size_ + 1) > keys_.size()) rehash(2 * keys_.size());
+    size_t i = Hash{}(k) & mask_;
+    for (; !(keys_[i] == empty_); i = (i + 1) & mask_)
+      if (keys_[i] == k) return {&vals_[i], false};
+    keys_[i] = k;
+    vals_[i] = v;
+    ++size_;
+    return {&vals_[i], true};
+  }
+  template <class F>
+  void forEach(F&& f) {
+    for (size_t i = 0; i < keys_.size(); ++i)
+      if (!(keys_[i] == empty_)) f(keys_[i], vals_[i]);
+  }
+
+ private:
+  void rehash(size_t capacity) {
+    std::vector<Key> keys(capacity, empty_);
+    std::vector<Value> vals(capacity);
+    keys.swap(keys_);
+    vals.swap(vals_);
+    mask_ = capacity - 1;
+    size_ = 0;
+    for (size_t i = 0; i < keys.size(); ++i)
+      if (!(keys[i] == empty_)) tryEmplace(keys[i], vals[i]);
+  }
+  Key empty_;
+  std::vector<Key> keys_;
+  std::vector<Value> vals_;
+  size_t mask_ = 0, size_ = 0;
+};
+struct EdgeKeyHash {
+  size_t operator()(std::uint64_t k) const { return static_cast<size_t>((k * 0x9E3779B97F4A7C15ull) >> 20); }
+};
+using EdgeMap = FlatMap<std::uint64_t, std::int32_t, EdgeKeyHash>;
+constexpr std::uint64_t kNoEdge = ~0ull;
+struct FaceFlatHash {
+  size_t operator()(const FaceKey& k) const {
+    const std::uint64_t h = (static_cast<std::uint64_t>(static_cast<std::uint32_t>(k.v[0])) * 0x9E3779B97F4A7C15ull) ^
+                            (static_cast<std::uint64_t>(static_cast<std::uint32_t>(k.v[1])) * 0xC2B2AE3D27D4EB4Full) ^
+                            (static_cast<std::uint64_t>(static_cast<std::uint32_t>(k.v[2])) * 0x165667B19E3779F9ull);
+    return static_cast<size_t>((h ^ (h >> 29)) * 0xBF58476D1CE4E5B9ull >> 20);
+  }
+};
+constexpr FaceKey kNoFace{{-1, -1, -1}};
+
 FaceKey makeFace(std::int32_t a, std::int32_t b, std::int32_t c) {
   // Sorted (three compare-exchanges).
   if (a > b) std::swap(a, b);
@@ -176,7 +241,7 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
   on.assign(N0, 0);
   std::vector<CrossedEdge> crossed;
   std::vector<Vec3> crossedNormal;    // surface: normal of the hit triangle per crossed edge
-  std::unordered_map<std::uint64_t, std::int32_t> edgeIndex;  // crossed edge -> index
+  EdgeMap edgeIndex(kNoEdge);  // crossed edge -> index
   std::vector<std::int32_t> crossedTets;
   std::vector<std::int32_t> onNodes;  // original nodes on the surface
   if (plane) {
@@ -202,10 +267,9 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
         const int a = input.T(t, e[0]), b = input.T(t, e[1]);
         if (!((phi[a] > eps && phi[b] < -eps) || (phi[a] < -eps && phi[b] > eps))) continue;
         const auto key = edgeKey(a, b);
-        if (edgeIndex.count(key)) continue;
+        if (!edgeIndex.tryEmplace(key, static_cast<std::int32_t>(crossed.size())).second) continue;
         const int lo_ = std::min(a, b), hi_ = std::max(a, b);
         const double tt = phi[lo_] / (phi[lo_] - phi[hi_]);
-        edgeIndex.emplace(key, static_cast<std::int32_t>(crossed.size()));
         crossed.push_back({lo_, hi_, tt, Vec3::Zero(), true});
       }
     }
@@ -215,12 +279,14 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
     for (int t = 0; t < M0; ++t) {
       Eigen::AlignedBox3d box;
       for (int k = 0; k < 4; ++k) box.extend(input.X.row(input.T(t, k)).transpose());
-      if (!surface.mayTouch(box, eps)) continue;
+      // Tets away from every leaf of the surface's tree have no node on it and no crossed
+      // edge (the margin 2 eps only adds tets, which then find nothing).
+      if (!surface.mayTouch(box, 2 * eps)) continue;
       for (int k = 0; k < 4; ++k) {
         const int v = input.T(t, k);
         if (seen[v]) continue;
         seen[v] = 1;
-        if (std::abs(surface.signedDistance(input.X.row(v).transpose())) <= eps) {
+        if (surface.within(input.X.row(v).transpose(), eps)) {
           on[v] = 1;
           onNodes.push_back(v);
         }
@@ -230,14 +296,14 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
         const int a = std::min(input.T(t, e[0]), input.T(t, e[1]));
         const int b = std::max(input.T(t, e[0]), input.T(t, e[1]));
         const auto key = edgeKey(a, b);
-        if (edgeIndex.count(key)) {
+        if (edgeIndex.contains(key)) {
           any = true;
           continue;
         }
         if (on[a] || on[b] || !tested.insert(key).second) continue;
         CutSurface::Hit hit;
         if (!surface.intersectSegment(input.X.row(a).transpose(), input.X.row(b).transpose(), eps, &hit)) continue;
-        edgeIndex.emplace(key, static_cast<std::int32_t>(crossed.size()));
+        edgeIndex.tryEmplace(key, static_cast<std::int32_t>(crossed.size()));
         crossed.push_back({a, b, hit.t, hit.point, true});
         crossedNormal.push_back(hit.normal);
         any = true;
@@ -315,7 +381,7 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
             bfNbrs.push_back(v);
           }
       const size_t L = bfNbrs.size();
-      faceAt.assign(L * L, -1);
+      if (faceAt.size() < L * L) faceAt.resize(L * L, -1);  // all -1 between calls
       for (int s = starOff[n]; s < starOff[n + 1]; ++s) {
         const Tet tv = w.tet(starTet[s]);
         const int ln = findLocal(tv, n);
@@ -335,6 +401,10 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
             seenFaces.push_back({o[0], o[1], i0, i1, i2, 1});
           }
         }
+      }
+      for (const auto& q : seenFaces) {
+        const std::int32_t a = bfLocal[q.u], b = bfLocal[q.v];
+        faceAt[std::min(a, b) * L + std::max(a, b)] = -1;
       }
       for (int v : bfNbrs) bfLocal[v] = -1;
       bfStart[n] = static_cast<std::int32_t>(bfPool.size());
@@ -436,9 +506,9 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
             const auto fe = featureEdgesOf(n);
             const double reach = fe.straight ? region : fe.polyhedral ? 0.0 : std::min(region, options.feature_slide_fraction);
             for (int r : fe.to) {
-              const auto it = edgeIndex.find(edgeKey(n, r));
-              if (it == edgeIndex.end()) continue;
-              const CrossedEdge& re = crossed[it->second];
+              const std::int32_t* it = edgeIndex.find(edgeKey(n, r));
+              if (!it) continue;
+              const CrossedEdge& re = crossed[*it];
               if (!re.alive || (re.a == n ? re.t : 1.0 - re.t) > reach) continue;
               target = crossingPoint(re);
               slid = true;
@@ -499,8 +569,8 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
         const Tet tv = w.tet(starTet[s]);
         for (int k = 0; k < 4; ++k) {
           if (tv[k] == n) continue;
-          const auto it = edgeIndex.find(edgeKey(n, tv[k]));
-          if (it != edgeIndex.end()) crossed[it->second].alive = false;
+          const std::int32_t* it = edgeIndex.find(edgeKey(n, tv[k]));
+          if (it) crossed[*it].alive = false;
         }
       }
     }
@@ -537,8 +607,8 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
         const Tet tv = w.tet(starTet[s]);
         for (int k = 0; k < 4; ++k) {
           if (tv[k] == n) continue;
-          const auto it = edgeIndex.find(edgeKey(n, tv[k]));
-          if (it == edgeIndex.end() || !crossed[it->second].alive) continue;
+          const std::int32_t* it = edgeIndex.find(edgeKey(n, tv[k]));
+          if (!it || !crossed[*it].alive) continue;
           need = std::max(need, f / (1.0 - f) * std::abs(phi[tv[k]]));
         }
       }
@@ -594,9 +664,9 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
           const Tet tv = w.tet(starTet[s]);
           for (int k = 0; k < 4; ++k) {
             if (tv[k] == n) continue;
-            const auto it = edgeIndex.find(edgeKey(n, tv[k]));
-            if (it == edgeIndex.end()) continue;
-            CrossedEdge& ce = crossed[it->second];
+            const std::int32_t* it = edgeIndex.find(edgeKey(n, tv[k]));
+            if (!it) continue;
+            CrossedEdge& ce = crossed[*it];
             ce.t = phi[ce.a] / (phi[ce.a] - phi[ce.b]);
           }
         }
@@ -630,9 +700,9 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
           if (tv[k] == n) continue;
           // Edges crossed nearer n than their other end now end on the cut; the others
           // (crossed nearer the other end, which may itself be routed through) stay split.
-          const auto it = edgeIndex.find(edgeKey(n, tv[k]));
-          if (it == edgeIndex.end()) continue;
-          CrossedEdge& ce = crossed[it->second];
+          const std::int32_t* it = edgeIndex.find(edgeKey(n, tv[k]));
+          if (!it) continue;
+          CrossedEdge& ce = crossed[*it];
           if ((ce.a == n ? ce.t : 1.0 - ce.t) <= 0.5) ce.alive = false;
         }
       }
@@ -728,14 +798,14 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
     std::int8_t opposite[2];
     int count = 0;
   };
-  std::unordered_map<FaceKey, FaceUse, FaceKeyHash> onFaces;
+  FlatMap<FaceKey, FaceUse, FaceFlatHash> onFaces(kNoFace);
   if (options.separate) {
     for (int t : local) {
       const Tet tv = w.tet(t);
       for (int f = 0; f < 4; ++f) {
         const int i0 = tv[kFace[f][0]], i1 = tv[kFace[f][1]], i2 = tv[kFace[f][2]];
         if (!on[i0] || !on[i1] || !on[i2]) continue;
-        FaceUse& u = onFaces[makeFace(i0, i1, i2)];
+        FaceUse& u = *onFaces.tryEmplace(makeFace(i0, i1, i2), FaceUse{}).first;
         if (u.count < 2) {
           u.tet[u.count] = t;
           u.opposite[u.count] = static_cast<std::int8_t>(f);
@@ -744,7 +814,8 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
       }
     }
   }
-  std::unordered_set<FaceKey, FaceKeyHash> cutFaces;
+  FlatMap<FaceKey, std::uint8_t, FaceFlatHash> cutFaces(kNoFace);
+  std::vector<std::pair<FaceKey, FaceUse>> cutFaceList;
   std::vector<std::pair<std::int32_t, std::int8_t>> cutFaceSides;  // (tet, opposite local vertex)
   // Side of a tet at a face on the cut: the signed distance of the vertex opposite the face
   // (a node treated as on the surface without moving keeps its own small distance).
@@ -760,11 +831,11 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
     }
     return off != 0 ? off : routed;
   };
-  for (const auto& [key, use] : onFaces) {
-    if (use.count != 2) continue;
+  onFaces.forEach([&](const FaceKey& key, const FaceUse& use) {
+    if (use.count != 2) return;
     // Only a face between the two sides is cut (with through-node approximation, a face of
     // on-nodes may have both its tets on one side).
-    if (!approx.empty() && !(sideOf(use.tet[0], use.opposite[0]) * sideOf(use.tet[1], use.opposite[1]) < 0)) continue;
+    if (!approx.empty() && !(sideOf(use.tet[0], use.opposite[0]) * sideOf(use.tet[1], use.opposite[1]) < 0)) return;
     if (!plane) {
       // The face must lie in the surface, not just have its corners on it.
       const Vec3 a = w.x(key.v[0]), b = w.x(key.v[1]), c = w.x(key.v[2]);
@@ -789,16 +860,15 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
         const int o0 = w.tet(use.tet[0])[use.opposite[0]], o1 = w.tet(use.tet[1])[use.opposite[1]];
         const bool across = (!on[o0] && !on[o1] && crossesNear(w.x(o0), w.x(o1))) ||
                             crossesNear(centroid(use.tet[0]), centroid(use.tet[1]));
-        if (!across) continue;
+        if (!across) return;
       }
     }
-    cutFaces.insert(key);
-  }
+    cutFaces.tryEmplace(key, 1);
+    cutFaceList.emplace_back(key, use);
+  });
   // Deterministic order for the side records.
-  std::vector<FaceKey> cutFaceList(cutFaces.begin(), cutFaces.end());
-  std::sort(cutFaceList.begin(), cutFaceList.end(), [](const FaceKey& x, const FaceKey& y) { return x.v < y.v; });
-  for (const auto& key : cutFaceList) {
-    const auto& use = onFaces[key];
+  std::sort(cutFaceList.begin(), cutFaceList.end(), [](const auto& x, const auto& y) { return x.first.v < y.first.v; });
+  for (const auto& [key, use] : cutFaceList) {
     cutFaceSides.emplace_back(use.tet[0], use.opposite[0]);
     cutFaceSides.emplace_back(use.tet[1], use.opposite[1]);
   }
@@ -807,23 +877,30 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
   std::vector<std::int32_t> cutNodes;
   if (!cutFaceList.empty()) {
     for (const auto& key : cutFaceList)
-      for (int v : key.v) cutNodes.push_back(v);
+      for (int v : key.first.v) cutNodes.push_back(v);
     std::sort(cutNodes.begin(), cutNodes.end());
     cutNodes.erase(std::unique(cutNodes.begin(), cutNodes.end()), cutNodes.end());
     std::vector<std::int32_t> slot(w.numNodes(), -1);
     for (size_t i = 0; i < cutNodes.size(); ++i) slot[cutNodes[i]] = static_cast<std::int32_t>(i);
-    std::vector<std::vector<std::int32_t>> star(cutNodes.size());
-    for (int t : local) {
-      const Tet tv = w.tet(t);
-      for (int k = 0; k < 4; ++k)
-        if (slot[tv[k]] >= 0) star[slot[tv[k]]].push_back(t);
-    }
+    // Stars of the cut nodes within the local tets (CSR, each sorted).
     const size_t numCut = cutNodes.size();
-    std::vector<int> parent;
-    std::vector<std::int32_t> sepLocal, sepNbrs, firstTet;
+    std::vector<std::int32_t> cutStarOff(numCut + 1, 0), cutStarTet;
+    for (int t : local)
+      for (const int v : w.tet(t))
+        if (slot[v] >= 0) ++cutStarOff[slot[v] + 1];
+    for (size_t i = 0; i < numCut; ++i) cutStarOff[i + 1] += cutStarOff[i];
+    cutStarTet.resize(cutStarOff[numCut]);
+    {
+      std::vector<std::int32_t> fill(cutStarOff.begin(), cutStarOff.end() - 1);
+      for (int t : local)
+        for (const int v : w.tet(t))
+          if (slot[v] >= 0) cutStarTet[fill[slot[v]]++] = t;
+    }
+    std::vector<int> parent, copyOf;
+    std::vector<std::int32_t> sepLocal, sepNbrs, firstTet, firstUsed;
     for (size_t i = 0; i < numCut; ++i) {
       const int n = cutNodes[i];
-      auto& st = star[i];
+      const std::span<std::int32_t> st(cutStarTet.data() + cutStarOff[i], cutStarTet.data() + cutStarOff[i + 1]);
       std::sort(st.begin(), st.end());
       parent.resize(st.size());
       std::iota(parent.begin(), parent.end(), 0);
@@ -842,7 +919,8 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
             sepNbrs.push_back(v);
           }
       const size_t L = sepNbrs.size();
-      firstTet.assign(L * L, -1);
+      if (firstTet.size() < L * L) firstTet.resize(L * L, -1);  // all -1 between nodes
+      firstUsed.clear();
       for (size_t j = 0; j < st.size(); ++j) {
         const Tet tv = w.tet(st[j]);
         const int ln = findLocal(tv, n);
@@ -852,17 +930,20 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
           for (int k = 0; k < 3; ++k)
             if (tv[kFace[f][k]] != n) o[m++] = tv[kFace[f][k]];
           const std::int32_t a = sepLocal[o[0]], b = sepLocal[o[1]];
-          std::int32_t& first = firstTet[std::min(a, b) * L + std::max(a, b)];
+          const size_t at = std::min(a, b) * L + std::max(a, b);
+          std::int32_t& first = firstTet[at];
           if (first < 0) {
             first = static_cast<std::int32_t>(j);
-          } else if (!cutFaces.count(makeFace(n, o[0], o[1]))) {
+            firstUsed.push_back(static_cast<std::int32_t>(at));
+          } else if (!cutFaces.contains(makeFace(n, o[0], o[1]))) {
             parent[find(first)] = find(static_cast<int>(j));
           }
         }
       }
       for (int v : sepNbrs) sepLocal[v] = -1;
+      for (const std::int32_t at : firstUsed) firstTet[at] = -1;
       // The group of the first tet keeps n; every other group gets a copy.
-      std::vector<int> copyOf(st.size(), -1);
+      copyOf.assign(st.size(), -1);
       const int keep = find(0);
       for (size_t j = 0; j < st.size(); ++j) {
         const int g = find(static_cast<int>(j));

@@ -200,7 +200,41 @@ bool CutSurface::mayTouch(const Eigen::AlignedBox3d& box, double eps) const {
   Eigen::AlignedBox3d grown = box;
   grown.min().array() -= eps;
   grown.max().array() += eps;
-  return bounds_.intersects(grown);
+  // Down the tree: the box meets a leaf's box (a few triangles).
+  int stack[128];
+  int top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const Node& node = nodes_[stack[--top]];
+    if (!node.box.intersects(grown)) continue;
+    if (node.left < 0 || top + 2 > 128) return true;
+    stack[top++] = node.left;
+    stack[top++] = node.right;
+  }
+  return false;
+}
+
+bool CutSurface::within(const Eigen::Vector3d& x, double r) const {
+  if (is_plane_) return std::abs(normal_.dot(x - point_)) <= r;
+  // Boxes farther than r (with a margin for rounding) cannot hold a triangle within r.
+  const double limit = r * r * (1.0 + 1e-6) + std::numeric_limits<double>::min();
+  int stack[128];
+  int top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const Node& node = nodes_[stack[--top]];
+    if (node.box.squaredExteriorDistance(x) > limit) continue;
+    if (node.left < 0) {
+      for (int i = node.begin; i < node.end; ++i) {
+        const Tri& t = tri_[order_[i]];
+        if (std::sqrt((closestPointOnTriangle(x, t.a, t.b, t.c) - x).squaredNorm()) <= r) return true;
+      }
+    } else if (top + 2 <= 128) {
+      stack[top++] = node.left;
+      stack[top++] = node.right;
+    }
+  }
+  return false;
 }
 
 }  // namespace hysim::cutting
