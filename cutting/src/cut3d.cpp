@@ -148,41 +148,69 @@ std::vector<EndCandidate> endCandidates(const std::vector<CrossedEdge>& crossed,
   return out;
 }
 
-// Working mesh: the input arrays plus appended nodes and tets.
+// Working mesh: row-major copies of the input arrays (a node's or a tet's entries in one
+// place, which the local passes below read over and over) plus appended nodes and tets.
+// The output mesh is written once from them (Assemble).
 struct Work {
-  const TetMesh& in;
-  Positions& X0;                  // the output copy's original rows (may move)
-  Tets& T0;
-  std::vector<Vec3> extraX;       // appended nodes
-  std::vector<Tet> extraT;        // appended tets
-  std::vector<std::int32_t> extraMat;
+  std::vector<Vec3> X;             // #nodes: input rows (may move), then appended nodes
+  std::vector<Tet> T;              // #tets: input rows (modified in place), then appended tets
+  std::vector<std::int32_t> extraMat;  // material of the appended tets
   int N0, M0;
 
-  Work(const TetMesh& input, TetMesh& out) : in(input), X0(out.X), T0(out.T), N0(input.numNodes()), M0(input.numTets()) {}
-  int numNodes() const { return N0 + static_cast<int>(extraX.size()); }
-  int numTets() const { return M0 + static_cast<int>(extraT.size()); }
-  Vec3 x(int i) const { return i < N0 ? Vec3(X0.row(i).transpose()) : extraX[i - N0]; }
-  Tet tet(int t) const {
-    if (t < M0) return {T0(t, 0), T0(t, 1), T0(t, 2), T0(t, 3)};
-    return extraT[t - M0];
+  Work(const TetMesh& input, size_t extraNodes, size_t extraTets) : N0(input.numNodes()), M0(input.numTets()) {
+    X.reserve(N0 + extraNodes);
+    T.reserve(M0 + extraTets);
+    extraMat.reserve(extraTets);
+    X.resize(N0);
+    const double* c[3] = {input.X.col(0).data(), input.X.col(1).data(), input.X.col(2).data()};
+    for (int i = 0; i < N0; ++i) X[i] = Vec3(c[0][i], c[1][i], c[2][i]);
+    T.resize(M0);
+    const std::int32_t* d[4] = {input.T.col(0).data(), input.T.col(1).data(), input.T.col(2).data(),
+                                input.T.col(3).data()};
+    for (int t = 0; t < M0; ++t) T[t] = {d[0][t], d[1][t], d[2][t], d[3][t]};
   }
-  void setTet(int t, const Tet& v) {
-    if (t < M0) {
-      for (int k = 0; k < 4; ++k) T0(t, k) = v[k];
-    } else {
-      extraT[t - M0] = v;
-    }
-  }
-  int addTet(const Tet& v, std::int32_t material) {
-    extraT.push_back(v);
+  int numNodes() const { return static_cast<int>(X.size()); }
+  int numTets() const { return static_cast<int>(T.size()); }
+  const Vec3& x(int i) const { return X[i]; }
+  const Tet& tet(int t) const { return T[t]; }
+  void setTet(int t, const Tet& v) { T[t] = v; }
+  int addTet(Tet v, std::int32_t material) {
+    T.push_back(v);
     extraMat.push_back(material);
     return numTets() - 1;
   }
-  int addNode(const Vec3& p) {
-    extraX.push_back(p);
+  int addNode(Vec3 p) {
+    X.push_back(p);
     return numNodes() - 1;
   }
 };
+
+// Quick test for the usual case, an interior node: is every face containing n shared by an
+// even number of n's tets? XOR of a 64-bit hash of each face (by its other two nodes) over
+// the star: zero when every face occurs an even number of times; a face used once (a
+// boundary face; there are at least three around a boundary node) leaves a random non-zero
+// value (zero only with probability 2^-64). Branch-free over the six edges of each tet.
+inline std::uint64_t mix64(std::uint64_t x) {
+  x ^= x >> 30;
+  x *= 0xBF58476D1CE4E5B9ull;
+  x ^= x >> 27;
+  x *= 0x94D049BB133111EBull;
+  return x ^ (x >> 31);
+}
+template <class W>
+bool evenFacePairs(const W& w, int n, const std::vector<std::int32_t>& starOff, const std::vector<std::int32_t>& starTet) {
+  std::uint64_t acc = 0;
+  for (int s = starOff[n]; s < starOff[n + 1]; ++s) {
+    const auto& tv = w.tet(starTet[s]);
+    for (const auto& e : kEdge) {
+      const std::uint32_t a = static_cast<std::uint32_t>(tv[e[0]]), b = static_cast<std::uint32_t>(tv[e[1]]);
+      const std::uint64_t key = (static_cast<std::uint64_t>(std::min(a, b)) << 32) | std::max(a, b);
+      const std::uint64_t keep = (tv[e[0]] != n && tv[e[1]] != n) ? ~0ull : 0ull;
+      acc ^= mix64(key) & keep;
+    }
+  }
+  return acc == 0;
+}
 
 int findLocal(const Tet& t, int v) {
   for (int k = 0; k < 4; ++k)
@@ -203,37 +231,25 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
   const int N0 = input.numNodes(), M0 = input.numTets();
   if (M0 == 0 || N0 == 0) return Error{"cut3d: empty mesh"};
   if (input.material.size() != 0 && input.material.size() != M0) return Error{"cut3d: material size differs from #T"};
-  for (int t = 0; t < M0; ++t)
-    for (int k = 0; k < 4; ++k)
-      if (input.T(t, k) < 0 || input.T(t, k) >= N0)
-        return Error{"cut3d: tet " + std::to_string(t) + " has a node index out of range"};
+  if (input.T.minCoeff() < 0 || input.T.maxCoeff() >= N0)
+    for (int t = 0; t < M0; ++t)
+      for (int k = 0; k < 4; ++k)
+        if (input.T(t, k) < 0 || input.T(t, k) >= N0)
+          return Error{"cut3d: tet " + std::to_string(t) + " has a node index out of range"};
   if (!input.X.allFinite()) return Error{"cut3d: non-finite node coordinates"};
   if (!(options.snap_region >= 0 && options.snap_region <= 0.5)) return Error{"cut3d: snap_region must be in [0, 0.5]"};
 
   Cut3DResult result;
-  TetMesh& out = result.mesh;
-  out = input;
-  if (out.material.size() == 0) out.material = Labels::Zero(M0);
+  TetMesh& out = result.mesh;  // written at Assemble
   Cut3DReport& report = result.report;
   TopologyChange& change = result.change;
-  Work w(input, out);
+  auto materialOf = [&](int t) { return input.material.size() != 0 ? input.material(t) : 0; };
 
   const Vec3 lo = input.X.colwise().minCoeff().transpose(), hi = input.X.colwise().maxCoeff().transpose();
   const double diag = (hi - lo).norm();
   if (!(diag > 0)) return Error{"cut3d: degenerate mesh bounding box"};
   const double eps = options.on_surface_tolerance * diag;
   const bool plane = surface.isPlane();
-
-  // Node -> tets (CSR) of the input mesh.
-  std::vector<std::int32_t> starOff(N0 + 1, 0), starTet(4 * static_cast<size_t>(M0));
-  for (int t = 0; t < M0; ++t)
-    for (int k = 0; k < 4; ++k) ++starOff[input.T(t, k) + 1];
-  for (int i = 0; i < N0; ++i) starOff[i + 1] += starOff[i];
-  {
-    std::vector<std::int32_t> fill(starOff.begin(), starOff.end() - 1);
-    for (int t = 0; t < M0; ++t)
-      for (int k = 0; k < 4; ++k) starTet[fill[input.T(t, k)]++] = t;
-  }
 
   // 1. Classification. side: +1 / -1 strictly off the surface (where known), 0 on it or unknown.
   std::vector<double> phi;            // plane: signed distances
@@ -247,21 +263,20 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
   if (plane) {
     phi.resize(N0);
     const Vec3 n = surface.planeNormal(), p = surface.planePoint();
+    // Per node: 1 strictly on the positive side, 2 strictly on the negative side.
+    std::vector<std::uint8_t> sideBits(N0);
     for (int i = 0; i < N0; ++i) {
       phi[i] = n.dot(input.X.row(i).transpose() - p);
+      sideBits[i] = static_cast<std::uint8_t>((phi[i] > eps ? 1 : 0) | (phi[i] < -eps ? 2 : 0));
       if (std::abs(phi[i]) <= eps) {
         on[i] = 1;
         onNodes.push_back(i);
       }
     }
+    const std::int32_t* T0c[4] = {input.T.col(0).data(), input.T.col(1).data(), input.T.col(2).data(),
+                                  input.T.col(3).data()};
     for (int t = 0; t < M0; ++t) {
-      bool pos = false, neg = false;
-      for (int k = 0; k < 4; ++k) {
-        const double f = phi[input.T(t, k)];
-        pos = pos || f > eps;
-        neg = neg || f < -eps;
-      }
-      if (!(pos && neg)) continue;
+      if ((sideBits[T0c[0][t]] | sideBits[T0c[1][t]] | sideBits[T0c[2][t]] | sideBits[T0c[3][t]]) != 3) continue;
       crossedTets.push_back(t);
       for (const auto& e : kEdge) {
         const int a = input.T(t, e[0]), b = input.T(t, e[1]);
@@ -275,8 +290,24 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
     }
   } else {
     std::vector<std::uint8_t> seen(N0, 0);
-    std::unordered_set<std::uint64_t> tested;
+    FlatMap<std::uint64_t, std::uint8_t, EdgeKeyHash> tested(kNoEdge);
+    // Outcodes against the surface's box grown by 2 eps (bit per side and axis): a tet whose
+    // nodes share a bit lies beside that box, which is what mayTouch tests first.
+    std::vector<std::uint8_t> outcode(N0);
+    {
+      const Eigen::Array3d blo = surface.bounds().min().array() - 2 * eps, bhi = surface.bounds().max().array() + 2 * eps;
+      for (int i = 0; i < N0; ++i) {
+        std::uint8_t c = 0;
+        for (int d = 0; d < 3; ++d) {
+          const double x = input.X(i, d);
+          c |= static_cast<std::uint8_t>((x < blo[d] ? 1 : 0) << (2 * d));
+          c |= static_cast<std::uint8_t>((x > bhi[d] ? 1 : 0) << (2 * d + 1));
+        }
+        outcode[i] = c;
+      }
+    }
     for (int t = 0; t < M0; ++t) {
+      if (outcode[input.T(t, 0)] & outcode[input.T(t, 1)] & outcode[input.T(t, 2)] & outcode[input.T(t, 3)]) continue;
       Eigen::AlignedBox3d box;
       for (int k = 0; k < 4; ++k) box.extend(input.X.row(input.T(t, k)).transpose());
       // Tets away from every leaf of the surface's tree have no node on it and no crossed
@@ -300,7 +331,7 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
           any = true;
           continue;
         }
-        if (on[a] || on[b] || !tested.insert(key).second) continue;
+        if (on[a] || on[b] || !tested.tryEmplace(key, 1).second) continue;
         CutSurface::Hit hit;
         if (!surface.intersectSegment(input.X.row(a).transpose(), input.X.row(b).transpose(), eps, &hit)) continue;
         edgeIndex.tryEmplace(key, static_cast<std::int32_t>(crossed.size()));
@@ -314,6 +345,44 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
   }
   report.crossed_edges = static_cast<int>(crossed.size());
   report.crossed_elements = static_cast<int>(crossedTets.size());
+  // Room for what the cut appends (split nodes and their tets, copies), so that the working
+  // arrays are not copied as they grow (a guess; they still grow past it if needed).
+  Work w(input, 4 * crossed.size() + 64, 12 * crossed.size() + 64);
+
+  // Node -> tets (CSR) of the input mesh, complete (all tets, ascending) for the nodes within
+  // one edge step of the crossed tets and the nodes on the surface: the only stars the steps
+  // below look at (snap/away/route candidates are ends of crossed edges, feature tests look
+  // at their neighbours, subdivision and separation at the crossed tets and the nodes on the
+  // cut). Two passes over the tets mark those nodes and the tets around them.
+  std::vector<std::int32_t> starOff(N0 + 1, 0), starTet;
+  {
+    std::vector<std::uint8_t> near(N0, 0);
+    for (int t : crossedTets)
+      for (int k = 0; k < 4; ++k) near[input.T(t, k)] = 1;
+    for (int n : onNodes) near[n] = 1;
+    const std::int32_t* T0c[4] = {input.T.col(0).data(), input.T.col(1).data(), input.T.col(2).data(),
+                                  input.T.col(3).data()};
+    for (int t = 0; t < M0; ++t) {
+      const int a = T0c[0][t], b = T0c[1][t], c = T0c[2][t], d = T0c[3][t];
+      if ((near[a] | near[b] | near[c] | near[d]) & 1) near[a] = near[b] = near[c] = near[d] = near[a] | near[b] | near[c] | near[d] | 2;
+    }
+    std::vector<std::int32_t> around;  // tets with a node marked (either flag)
+    for (int t = 0; t < M0; ++t) {
+      const int a = T0c[0][t], b = T0c[1][t], c = T0c[2][t], d = T0c[3][t];
+      if (near[a] | near[b] | near[c] | near[d]) {
+        around.push_back(t);
+        ++starOff[a + 1];
+        ++starOff[b + 1];
+        ++starOff[c + 1];
+        ++starOff[d + 1];
+      }
+    }
+    for (int i = 0; i < N0; ++i) starOff[i + 1] += starOff[i];
+    starTet.resize(starOff[N0]);
+    std::vector<std::int32_t> fill(starOff.begin(), starOff.end() - 1);
+    for (int t : around)
+      for (int k = 0; k < 4; ++k) starTet[fill[T0c[k][t]]++] = t;
+  }
 
   auto crossingPoint = [&](const CrossedEdge& e) -> Vec3 {
     if (!plane) return e.point;
@@ -370,6 +439,10 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
   std::vector<Seen> seenFaces;
   std::vector<std::int32_t> bfNbrs, bfLocal(N0, -1), faceAt;
   auto boundaryFacesOf = [&](int n) {
+    if (bfStart[n] < 0 && evenFacePairs(w, n, starOff, starTet)) {
+      bfStart[n] = static_cast<std::int32_t>(bfPool.size());  // interior: no boundary face
+      bfCount[n] = 0;
+    }
     if (bfStart[n] < 0) {
       seenFaces.clear();
       // Local numbers of n's neighbours; faceAt: (pair of them) -> index in seenFaces.
@@ -557,7 +630,7 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
         refused[n] = 1;
         continue;
       }
-      w.X0.row(n) = target.transpose();
+      w.X[n] = target;
       on[n] = 1;
       if (plane) phi[n] = 0;
       onNodes.push_back(n);
@@ -658,7 +731,7 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
         if (step > maxStep) continue;
         const Vec3 target = w.x(n) + step * dir;
         if (!guardOk(n, target)) continue;
-        w.X0.row(n) = target.transpose();
+        w.X[n] = target;
         phi[n] = pn.dot(target - pp);
         for (int s = starOff[n]; s < starOff[n + 1]; ++s) {
           const Tet tv = w.tet(starTet[s]);
@@ -763,7 +836,7 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
           tv[lb] = pn;
           other[la] = pn;
           w.setTet(t, tv);
-          list.push_back(w.addTet(other, out.material(o)));
+          list.push_back(w.addTet(other, materialOf(o)));
         }
       }
     }
@@ -983,14 +1056,25 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
 
   // Assemble.
   const int N1 = w.numNodes(), M1 = w.numTets();
-  out.X.conservativeResize(N1, 3);
-  for (int i = N0; i < N1; ++i) out.X.row(i) = w.extraX[i - N0].transpose();
-  out.T.conservativeResize(M1, 4);
-  out.material.conservativeResize(M1);
-  for (int t = M0; t < M1; ++t) {
-    for (int k = 0; k < 4; ++k) out.T(t, k) = w.extraT[t - M0][k];
-    out.material(t) = w.extraMat[t - M0];
+  out.X.resize(N1, 3);
+  {
+    double* c[3] = {out.X.col(0).data(), out.X.col(1).data(), out.X.col(2).data()};
+    for (int i = 0; i < N1; ++i)
+      for (int k = 0; k < 3; ++k) c[k][i] = w.X[i][k];
   }
+  out.T.resize(M1, 4);
+  {
+    std::int32_t* d[4] = {out.T.col(0).data(), out.T.col(1).data(), out.T.col(2).data(), out.T.col(3).data()};
+    for (int t = 0; t < M1; ++t)
+      for (int k = 0; k < 4; ++k) d[k][t] = w.T[t][k];
+  }
+  out.material.resize(M1);
+  if (input.material.size() != 0) {
+    out.material.head(M0) = input.material;
+  } else {
+    out.material.head(M0).setZero();
+  }
+  for (int t = M0; t < M1; ++t) out.material(t) = w.extraMat[t - M0];
 
   change.old_num_nodes = N0;
   change.old_num_elements = M0;
@@ -1043,26 +1127,53 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
   if (deleting || anyPeeled) {
     // Compact: drop deleted and peeled tets and the nodes no longer used.
     auto dropped = [&](int t) { return (t < M0 && deleting && deleted[t]) || (anyPeeled && peeled[t]); };
-    std::vector<std::int32_t> tetMap(M1, -1), nodeMap(N1, -1);
+    std::vector<std::int32_t> tetMap(M1, -1), nodeMap(N1, -1), drop;
     int mt = 0;
-    for (int t = 0; t < M1; ++t)
-      if (!dropped(t)) tetMap[t] = mt++;
-    for (int t = 0; t < M1; ++t)
-      if (tetMap[t] >= 0)
-        for (int k = 0; k < 4; ++k) nodeMap[out.T(t, k)] = 1;
+    for (int t = 0; t < M1; ++t) {
+      if (!dropped(t)) {
+        tetMap[t] = mt++;
+      } else {
+        drop.push_back(t);
+      }
+    }
+    // Uses of each node by the kept tets (all uses minus those of the dropped tets): a node
+    // no kept tet uses goes.
+    for (int k = 0; k < 4; ++k) {
+      const std::int32_t* col = out.T.col(k).data();
+      for (int t = 0; t < M1; ++t) ++nodeMap[col[t]];  // from -1: uses - 1
+    }
+    for (int t : drop)
+      for (int k = 0; k < 4; ++k) --nodeMap[out.T(t, k)];
     int mn = 0;
-    for (int i = 0; i < N1; ++i) nodeMap[i] = nodeMap[i] > 0 ? mn++ : -1;
+    for (int i = 0; i < N1; ++i) nodeMap[i] = nodeMap[i] >= 0 ? mn++ : -1;
+    // Kept rows in runs between the dropped tets (nodes likewise).
+    auto keepRows = [](const auto& from, auto& to, const std::vector<std::int32_t>& gaps) {
+      Eigen::Index src = 0, dst = 0;
+      for (size_t g = 0; g <= gaps.size(); ++g) {
+        const Eigen::Index end = g < gaps.size() ? gaps[g] : from.rows();
+        if (end > src) to.middleRows(dst, end - src) = from.middleRows(src, end - src);
+        dst += end - src;
+        src = end + 1;
+      }
+    };
     TetMesh compact;
-    compact.X.resize(mn, 3);
     compact.T.resize(mt, 4);
     compact.material.resize(mt);
-    for (int i = 0; i < N1; ++i)
-      if (nodeMap[i] >= 0) compact.X.row(nodeMap[i]) = out.X.row(i);
-    for (int t = 0; t < M1; ++t)
-      if (tetMap[t] >= 0) {
-        for (int k = 0; k < 4; ++k) compact.T(tetMap[t], k) = nodeMap[out.T(t, k)];
-        compact.material(tetMap[t]) = out.material(t);
+    keepRows(out.T, compact.T, drop);
+    keepRows(out.material, compact.material, drop);
+    if (mn == N1) {
+      compact.X = std::move(out.X);
+    } else {
+      std::vector<std::int32_t> gone;
+      for (int i = 0; i < N1; ++i)
+        if (nodeMap[i] < 0) gone.push_back(i);
+      compact.X.resize(mn, 3);
+      keepRows(out.X, compact.X, gone);
+      for (int k = 0; k < 4; ++k) {
+        std::int32_t* col = compact.T.col(k).data();
+        for (int t = 0; t < mt; ++t) col[t] = nodeMap[col[t]];
       }
+    }
     out = std::move(compact);
     for (int i = 0; i < N0; ++i) change.node_old_to_new[i] = nodeMap[i];
     for (int t = 0; t < M0; ++t) {
