@@ -117,6 +117,11 @@ FaceKey makeFace(std::int32_t a, std::int32_t b, std::int32_t c) {
 // Outward faces of a positive tet, by the local index of the opposite vertex.
 constexpr int kFace[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
 constexpr int kEdge[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
+// The three faces of a tet containing its vertex k, each by its two other vertices.
+constexpr int kFacePairs[4][3][2] = {{{2, 3}, {1, 3}, {1, 2}},
+                                     {{2, 3}, {0, 3}, {0, 2}},
+                                     {{1, 3}, {0, 3}, {0, 1}},
+                                     {{1, 2}, {0, 2}, {0, 1}}};
 
 double signedVolume(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
   return (b - a).dot((c - a).cross(d - a)) / 6.0;
@@ -345,6 +350,9 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
   }
   report.crossed_edges = static_cast<int>(crossed.size());
   report.crossed_elements = static_cast<int>(crossedTets.size());
+  // Ends of crossed edges: an edge whose ends are not both marked is not in edgeIndex.
+  std::vector<std::uint8_t> crossEnd(N0, 0);
+  for (const auto& ce : crossed) crossEnd[ce.a] = crossEnd[ce.b] = 1;
   // Room for what the cut appends (split nodes and their tets, copies), so that the working
   // arrays are not copied as they grow (a guess; they still grow past it if needed).
   Work w(input, 4 * crossed.size() + 64, 12 * crossed.size() + 64);
@@ -364,7 +372,12 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
                                   input.T.col(3).data()};
     for (int t = 0; t < M0; ++t) {
       const int a = T0c[0][t], b = T0c[1][t], c = T0c[2][t], d = T0c[3][t];
-      if ((near[a] | near[b] | near[c] | near[d]) & 1) near[a] = near[b] = near[c] = near[d] = near[a] | near[b] | near[c] | near[d] | 2;
+      if ((near[a] | near[b] | near[c] | near[d]) & 1) {
+        near[a] |= 2;
+        near[b] |= 2;
+        near[c] |= 2;
+        near[d] |= 2;
+      }
     }
     std::vector<std::int32_t> around;  // tets with a node marked (either flag)
     for (int t = 0; t < M0; ++t) {
@@ -397,10 +410,14 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
   // Moving node n to `target` keeps every tet of its star positive, not flat and not badly
   // degraded (q* below min(before, min_quality)), and every edge of n at least
   // min_edge_fraction of its length.
+  // (The conditions are independent, so they are tested cheapest first, and each edge of n
+  // once although several tets share it.)
+  std::vector<std::uint8_t> guardSeen(N0, 0);
+  std::vector<std::int32_t> guardNbrs;
   auto guardOk = [&](int n, const Vec3& target) {
     const Vec3 old = w.x(n);
     for (int s = starOff[n]; s < starOff[n + 1]; ++s) {
-      const Tet tv = w.tet(starTet[s]);
+      const Tet& tv = w.tet(starTet[s]);
       Vec3 p[4], q[4];
       for (int k = 0; k < 4; ++k) {
         p[k] = w.x(tv[k]);
@@ -409,12 +426,31 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
       const double v0 = signedVolume(p[0], p[1], p[2], p[3]);
       const double v1 = signedVolume(q[0], q[1], q[2], q[3]);
       if (!(v1 > 1e-3 * v0)) return false;
+    }
+    guardNbrs.clear();
+    bool ok = true;
+    for (int s = starOff[n]; s < starOff[n + 1] && ok; ++s)
+      for (const int v : w.tet(starTet[s])) {
+        if (v == n || guardSeen[v]) continue;
+        guardSeen[v] = 1;
+        guardNbrs.push_back(v);
+        const Vec3& pv = w.x(v);
+        if ((pv - target).norm() < options.min_edge_fraction * (pv - old).norm()) {
+          ok = false;
+          break;
+        }
+      }
+    for (const int v : guardNbrs) guardSeen[v] = 0;
+    if (!ok) return false;
+    for (int s = starOff[n]; s < starOff[n + 1]; ++s) {
+      const Tet& tv = w.tet(starTet[s]);
+      Vec3 p[4], q[4];
+      for (int k = 0; k < 4; ++k) {
+        p[k] = w.x(tv[k]);
+        q[k] = tv[k] == n ? target : p[k];
+      }
       const double qa = radiusRatio(q[0], q[1], q[2], q[3]);
       if (qa < options.min_quality && qa < radiusRatio(p[0], p[1], p[2], p[3])) return false;
-      for (int k = 0; k < 4; ++k) {
-        if (tv[k] == n) continue;
-        if ((q[k] - target).norm() < options.min_edge_fraction * (p[k] - old).norm()) return false;
-      }
     }
     return true;
   };
@@ -641,7 +677,7 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
       for (int s = starOff[n]; s < starOff[n + 1]; ++s) {
         const Tet tv = w.tet(starTet[s]);
         for (int k = 0; k < 4; ++k) {
-          if (tv[k] == n) continue;
+          if (tv[k] == n || !crossEnd[tv[k]]) continue;
           const std::int32_t* it = edgeIndex.find(edgeKey(n, tv[k]));
           if (it) crossed[*it].alive = false;
         }
@@ -679,7 +715,7 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
       for (int s = starOff[n]; s < starOff[n + 1]; ++s) {
         const Tet tv = w.tet(starTet[s]);
         for (int k = 0; k < 4; ++k) {
-          if (tv[k] == n) continue;
+          if (tv[k] == n || !crossEnd[tv[k]]) continue;
           const std::int32_t* it = edgeIndex.find(edgeKey(n, tv[k]));
           if (!it || !crossed[*it].alive) continue;
           need = std::max(need, f / (1.0 - f) * std::abs(phi[tv[k]]));
@@ -736,7 +772,7 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
         for (int s = starOff[n]; s < starOff[n + 1]; ++s) {
           const Tet tv = w.tet(starTet[s]);
           for (int k = 0; k < 4; ++k) {
-            if (tv[k] == n) continue;
+            if (tv[k] == n || !crossEnd[tv[k]]) continue;
             const std::int32_t* it = edgeIndex.find(edgeKey(n, tv[k]));
             if (!it) continue;
             CrossedEdge& ce = crossed[*it];
@@ -770,7 +806,7 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
       for (int s = starOff[n]; s < starOff[n + 1]; ++s) {
         const Tet tv = w.tet(starTet[s]);
         for (int k = 0; k < 4; ++k) {
-          if (tv[k] == n) continue;
+          if (tv[k] == n || !crossEnd[tv[k]]) continue;
           // Edges crossed nearer n than their other end now end on the cut; the others
           // (crossed nearer the other end, which may itself be routed through) stay split.
           const std::int32_t* it = edgeIndex.find(edgeKey(n, tv[k]));
@@ -846,8 +882,8 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
   // 4. Separation. Local tets: the current stars of all nodes on the cut.
   auto isDeleted = [&](int t) { return deleting && t < M0 && deleted[t]; };
   std::vector<std::int32_t> local;
+  std::vector<std::uint8_t> inLocal(w.numTets(), 0);
   {
-    std::vector<std::uint8_t> inLocal(w.numTets(), 0);
     auto add = [&](int t) {
       if (!inLocal[t] && !isDeleted(t)) {
         inLocal[t] = 1;
@@ -955,17 +991,21 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
     cutNodes.erase(std::unique(cutNodes.begin(), cutNodes.end()), cutNodes.end());
     std::vector<std::int32_t> slot(w.numNodes(), -1);
     for (size_t i = 0; i < cutNodes.size(); ++i) slot[cutNodes[i]] = static_cast<std::int32_t>(i);
-    // Stars of the cut nodes within the local tets (CSR, each sorted).
+    // Stars of the cut nodes within the local tets (CSR, each ascending: filled from the
+    // local tets in ascending order).
     const size_t numCut = cutNodes.size();
-    std::vector<std::int32_t> cutStarOff(numCut + 1, 0), cutStarTet;
-    for (int t : local)
+    std::vector<std::int32_t> cutStarOff(numCut + 1, 0), cutStarTet, localSorted;
+    localSorted.reserve(local.size());
+    for (int t = 0; t < static_cast<int>(inLocal.size()); ++t)
+      if (inLocal[t]) localSorted.push_back(t);
+    for (int t : localSorted)
       for (const int v : w.tet(t))
         if (slot[v] >= 0) ++cutStarOff[slot[v] + 1];
     for (size_t i = 0; i < numCut; ++i) cutStarOff[i + 1] += cutStarOff[i];
     cutStarTet.resize(cutStarOff[numCut]);
     {
       std::vector<std::int32_t> fill(cutStarOff.begin(), cutStarOff.end() - 1);
-      for (int t : local)
+      for (int t : localSorted)
         for (const int v : w.tet(t))
           if (slot[v] >= 0) cutStarTet[fill[slot[v]]++] = t;
     }
@@ -974,7 +1014,6 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
     for (size_t i = 0; i < numCut; ++i) {
       const int n = cutNodes[i];
       const std::span<std::int32_t> st(cutStarTet.data() + cutStarOff[i], cutStarTet.data() + cutStarOff[i + 1]);
-      std::sort(st.begin(), st.end());
       parent.resize(st.size());
       std::iota(parent.begin(), parent.end(), 0);
       auto find = [&](int x) {
@@ -997,18 +1036,16 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
       for (size_t j = 0; j < st.size(); ++j) {
         const Tet tv = w.tet(st[j]);
         const int ln = findLocal(tv, n);
-        for (int f = 0; f < 4; ++f) {
-          if (f == ln) continue;
-          std::int32_t o[2], m = 0;
-          for (int k = 0; k < 3; ++k)
-            if (tv[kFace[f][k]] != n) o[m++] = tv[kFace[f][k]];
+        for (const auto& pair : kFacePairs[ln]) {
+          const std::int32_t o[2] = {tv[pair[0]], tv[pair[1]]};
           const std::int32_t a = sepLocal[o[0]], b = sepLocal[o[1]];
           const size_t at = std::min(a, b) * L + std::max(a, b);
           std::int32_t& first = firstTet[at];
           if (first < 0) {
             first = static_cast<std::int32_t>(j);
             firstUsed.push_back(static_cast<std::int32_t>(at));
-          } else if (!cutFaces.contains(makeFace(n, o[0], o[1]))) {
+          } else if (!(on[o[0]] && on[o[1]]) || !cutFaces.contains(makeFace(n, o[0], o[1]))) {
+            // (Every cut face has its three nodes on the cut, so most faces need no lookup.)
             parent[find(first)] = find(static_cast<int>(j));
           }
         }
