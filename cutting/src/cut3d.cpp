@@ -644,7 +644,7 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
           }
           target = w.x(n) - (dist / slope) * d;
           // A curved surface: the hit triangle's plane is only good where it is the surface.
-          if (!plane && std::abs(surface.signedDistance(target)) > 10 * eps) {
+          if (!plane && !surface.within(target, 10 * eps)) {
             ++report.feature_skips;
             continue;
           }
@@ -950,7 +950,7 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
       const Vec3 a = w.x(key.v[0]), b = w.x(key.v[1]), c = w.x(key.v[2]);
       const double size = std::max({(b - a).norm(), (c - a).norm(), (c - b).norm()});
       const Vec3 centre = (a + b + c) / 3.0;
-      if (std::abs(surface.signedDistance(centre)) > eps + 0.05 * size) {
+      if (!surface.within(centre, eps + 0.05 * size)) {
         // On a curved surface a flat face with its corners on the surface lies off it by the
         // sagitta (about size^2 / (8 R)), and a thin tet beside it may lie wholly on the far
         // side of the surface. The face is still on the cut when the surface passes between

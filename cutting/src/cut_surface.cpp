@@ -74,6 +74,21 @@ int CutSurface::build(int begin, int end) {
   return id;
 }
 
+namespace {
+// AlignedBox::squaredExteriorDistance without branches (the tree walks test many boxes):
+// the same terms summed in the same order (a zero term leaves the sum unchanged), so the
+// same value bit for bit, NaN coordinates included (they add nothing).
+inline double boxDistance2(const Eigen::AlignedBox3d& box, const Eigen::Vector3d& p) {
+  double dist2 = 0;
+  for (int k = 0; k < 3; ++k) {
+    const double below = box.min()[k] - p[k], above = p[k] - box.max()[k];
+    const double aux = (below > 0 ? below : 0.0) + (above > 0 ? above : 0.0);
+    dist2 += aux * aux;
+  }
+  return dist2;
+}
+}  // namespace
+
 Eigen::Vector3d closestPointOnTriangle(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                                        const Eigen::Vector3d& c) {
   // Voronoi-region walk (Ericson, Real-Time Collision Detection, 5.1.5).
@@ -110,7 +125,7 @@ double CutSurface::signedDistance(const Eigen::Vector3d& x, Eigen::Vector3d* clo
   stack[top++] = 0;
   while (top > 0) {
     const Node& node = nodes_[stack[--top]];
-    if (node.box.squaredExteriorDistance(x) >= best) continue;
+    if (boxDistance2(node.box, x) >= best) continue;
     if (node.left < 0) {
       for (int i = node.begin; i < node.end; ++i) {
         const Tri& t = tri_[order_[i]];
@@ -223,7 +238,7 @@ bool CutSurface::within(const Eigen::Vector3d& x, double r) const {
   stack[top++] = 0;
   while (top > 0) {
     const Node& node = nodes_[stack[--top]];
-    if (node.box.squaredExteriorDistance(x) > limit) continue;
+    if (boxDistance2(node.box, x) > limit) continue;
     if (node.left < 0) {
       for (int i = node.begin; i < node.end; ++i) {
         const Tri& t = tri_[order_[i]];
