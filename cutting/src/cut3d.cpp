@@ -1011,6 +1011,7 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
     }
     std::vector<int> parent, copyOf;
     std::vector<std::int32_t> sepLocal, sepNbrs, firstTet, firstUsed;
+    std::vector<std::array<std::int32_t, 4>> facePairs;  // first tet, tet, the face's other two nodes
     for (size_t i = 0; i < numCut; ++i) {
       const int n = cutNodes[i];
       const std::span<std::int32_t> st(cutStarTet.data() + cutStarOff[i], cutStarTet.data() + cutStarOff[i + 1]);
@@ -1032,26 +1033,32 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
           }
       const size_t L = sepNbrs.size();
       if (firstTet.size() < L * L) firstTet.resize(L * L, -1);  // all -1 between nodes
-      firstUsed.clear();
-      for (size_t j = 0; j < st.size(); ++j) {
-        const Tet tv = w.tet(st[j]);
+      // Pass 1 (without data-dependent branches): each face occurrence after the first
+      // gives a pair (first tet, this tet). Pass 2: pairs not across a cut face are joined.
+      firstUsed.resize(3 * st.size());
+      facePairs.resize(3 * st.size());
+      size_t numPairs = 0;
+      for (size_t j = 0, q = 0; j < st.size(); ++j) {
+        const Tet& tv = w.tet(st[j]);
         const int ln = findLocal(tv, n);
         for (const auto& pair : kFacePairs[ln]) {
-          const std::int32_t o[2] = {tv[pair[0]], tv[pair[1]]};
-          const std::int32_t a = sepLocal[o[0]], b = sepLocal[o[1]];
-          const size_t at = std::min(a, b) * L + std::max(a, b);
-          std::int32_t& first = firstTet[at];
-          if (first < 0) {
-            first = static_cast<std::int32_t>(j);
-            firstUsed.push_back(static_cast<std::int32_t>(at));
-          } else if (!(on[o[0]] && on[o[1]]) || !cutFaces.contains(makeFace(n, o[0], o[1]))) {
-            // (Every cut face has its three nodes on the cut, so most faces need no lookup.)
-            parent[find(first)] = find(static_cast<int>(j));
-          }
+          const std::int32_t o0 = tv[pair[0]], o1 = tv[pair[1]];
+          const std::int32_t a = sepLocal[o0], b = sepLocal[o1];
+          const std::int32_t at = static_cast<std::int32_t>(std::min(a, b) * L + std::max(a, b));
+          const std::int32_t first = firstTet[at];
+          firstTet[at] = first < 0 ? static_cast<std::int32_t>(j) : first;
+          firstUsed[q++] = at;
+          facePairs[numPairs] = {first, static_cast<std::int32_t>(j), o0, o1};
+          numPairs += first >= 0 ? 1 : 0;
         }
       }
       for (int v : sepNbrs) sepLocal[v] = -1;
       for (const std::int32_t at : firstUsed) firstTet[at] = -1;
+      for (size_t q = 0; q < numPairs; ++q) {
+        const auto& [first, j, o0, o1] = facePairs[q];
+        // (Every cut face has its three nodes on the cut, so most faces need no lookup.)
+        if (!(on[o0] && on[o1]) || !cutFaces.contains(makeFace(n, o0, o1))) parent[find(first)] = find(j);
+      }
       // The group of the first tet keeps n; every other group gets a copy.
       copyOf.assign(st.size(), -1);
       const int keep = find(0);
