@@ -10,7 +10,6 @@
 #include <span>
 #include <string>
 #include <unordered_map>
-#include <unordered_set>
 
 #include "hysim/cutting/mesh_stats.hpp"
 #include "optimize3d_internal.hpp"
