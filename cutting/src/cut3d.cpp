@@ -177,7 +177,15 @@ struct Work {
   int numTets() const { return static_cast<int>(T.size()); }
   const Vec3& x(int i) const { return X[i]; }
   const Tet& tet(int t) const { return T[t]; }
-  void setTet(int t, const Tet& v) { T[t] = v; }
+  std::vector<std::int32_t> changedNodes, changedTets;  // input rows written (may repeat)
+  void setTet(int t, const Tet& v) {
+    T[t] = v;
+    if (t < M0) changedTets.push_back(t);
+  }
+  void setX(int i, const Vec3& p) {
+    X[i] = p;
+    if (i < N0) changedNodes.push_back(i);
+  }
   int addTet(Tet v, std::int32_t material) {
     T.push_back(v);
     extraMat.push_back(material);
@@ -665,7 +673,7 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
         refused[n] = 1;
         continue;
       }
-      w.X[n] = target;
+      w.setX(n, target);
       on[n] = 1;
       if (plane) phi[n] = 0;
       onNodes.push_back(n);
@@ -766,7 +774,7 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
         if (step > maxStep) continue;
         const Vec3 target = w.x(n) + step * dir;
         if (!guardOk(n, target)) continue;
-        w.X[n] = target;
+        w.setX(n, target);
         phi[n] = pn.dot(target - pp);
         for (int s = starOff[n]; s < starOff[n + 1]; ++s) {
           const Tet tv = w.tet(starTet[s]);
@@ -1099,16 +1107,18 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
 
   // Assemble.
   const int N1 = w.numNodes(), M1 = w.numTets();
+  // The input arrays (column copies), the rows the cut wrote, then the appended rows.
   out.X.resize(N1, 3);
-  {
-    double* c[3] = {out.X.col(0).data(), out.X.col(1).data(), out.X.col(2).data()};
-    for (int i = 0; i < N1; ++i)
-      for (int k = 0; k < 3; ++k) c[k][i] = w.X[i][k];
-  }
+  out.X.topRows(N0) = input.X;
+  for (const int i : w.changedNodes) out.X.row(i) = w.X[i].transpose();
+  for (int i = N0; i < N1; ++i) out.X.row(i) = w.X[i].transpose();
   out.T.resize(M1, 4);
+  out.T.topRows(M0) = input.T;
   {
     std::int32_t* d[4] = {out.T.col(0).data(), out.T.col(1).data(), out.T.col(2).data(), out.T.col(3).data()};
-    for (int t = 0; t < M1; ++t)
+    for (const int t : w.changedTets)
+      for (int k = 0; k < 4; ++k) d[k][t] = w.T[t][k];
+    for (int t = M0; t < M1; ++t)
       for (int k = 0; k < 4; ++k) d[k][t] = w.T[t][k];
   }
   out.material.resize(M1);
