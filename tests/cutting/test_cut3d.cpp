@@ -364,7 +364,9 @@ TEST(Cut3D, SurfaceWithinAndMayTouch) {
     // A point's own box touches the surface iff the point is within eps of it (up to the
     // leaf boxes being larger than their triangles: mayTouch may say yes, never wrongly no).
     const Eigen::AlignedBox3d box(x, x);
-    if (std::abs(s.signedDistance(x)) <= 0.05) EXPECT_TRUE(s.mayTouch(box, 0.05));
+    if (std::abs(s.signedDistance(x)) <= 0.05) {
+      EXPECT_TRUE(s.mayTouch(box, 0.05));
+    }
   }
   EXPECT_GT(near, 100);
   // The axis of the cylinder lies inside the strip's bounding box, 0.5 from every triangle.
