@@ -7,9 +7,9 @@
 #include <cmath>
 #include <limits>
 #include <numeric>
+#include <span>
 #include <string>
 #include <unordered_map>
-#include <unordered_set>
 
 #include "hysim/cutting/mesh_stats.hpp"
 #include "optimize3d_internal.hpp"
@@ -41,6 +41,70 @@ struct FaceKeyHash {
     return static_cast<size_t>(h);
   }
 };
+// Open-addressing hash map (linear probing, power-of-two capacity) for the small maps of a
+// cut: crossed edges, faces on the cut. Much cheaper than std::unordered_map (no node per
+// entry); lookups only, so its layout never affects the results. `empty` is a key no entry
+// uses.
+template <class Key, class Value, class Hash>
+class FlatMap {
+ public:
+  explicit FlatMap(Key empty) : empty_(empty) { rehash(64); }
+  size_t size() const { return size_; }
+  Value* find(const Key& k) {
+    for (size_t i = Hash{}(k) & mask_;; i = (i + 1) & mask_) {
+      if (keys_[i] == k) return &vals_[i];
+      if (keys_[i] == empty_) return nullptr;
+    }
+  }
+  bool contains(const Key& k) { return find(k) != nullptr; }
+  // The value for k, inserting `v` if absent; second: whether it was inserted.
+  std::pair<Value*, bool> tryEmplace(const Key& k, const Value& v) {
+    if (2 * (size_ + 1) > keys_.size()) rehash(2 * keys_.size());
+    size_t i = Hash{}(k) & mask_;
+    for (; !(keys_[i] == empty_); i = (i + 1) & mask_)
+      if (keys_[i] == k) return {&vals_[i], false};
+    keys_[i] = k;
+    vals_[i] = v;
+    ++size_;
+    return {&vals_[i], true};
+  }
+  template <class F>
+  void forEach(F&& f) {
+    for (size_t i = 0; i < keys_.size(); ++i)
+      if (!(keys_[i] == empty_)) f(keys_[i], vals_[i]);
+  }
+
+ private:
+  void rehash(size_t capacity) {
+    std::vector<Key> keys(capacity, empty_);
+    std::vector<Value> vals(capacity);
+    keys.swap(keys_);
+    vals.swap(vals_);
+    mask_ = capacity - 1;
+    size_ = 0;
+    for (size_t i = 0; i < keys.size(); ++i)
+      if (!(keys[i] == empty_)) tryEmplace(keys[i], vals[i]);
+  }
+  Key empty_;
+  std::vector<Key> keys_;
+  std::vector<Value> vals_;
+  size_t mask_ = 0, size_ = 0;
+};
+struct EdgeKeyHash {
+  size_t operator()(std::uint64_t k) const { return static_cast<size_t>((k * 0x9E3779B97F4A7C15ull) >> 20); }
+};
+using EdgeMap = FlatMap<std::uint64_t, std::int32_t, EdgeKeyHash>;
+constexpr std::uint64_t kNoEdge = ~0ull;
+struct FaceFlatHash {
+  size_t operator()(const FaceKey& k) const {
+    const std::uint64_t h = (static_cast<std::uint64_t>(static_cast<std::uint32_t>(k.v[0])) * 0x9E3779B97F4A7C15ull) ^
+                            (static_cast<std::uint64_t>(static_cast<std::uint32_t>(k.v[1])) * 0xC2B2AE3D27D4EB4Full) ^
+                            (static_cast<std::uint64_t>(static_cast<std::uint32_t>(k.v[2])) * 0x165667B19E3779F9ull);
+    return static_cast<size_t>((h ^ (h >> 29)) * 0xBF58476D1CE4E5B9ull >> 20);
+  }
+};
+constexpr FaceKey kNoFace{{-1, -1, -1}};
+
 FaceKey makeFace(std::int32_t a, std::int32_t b, std::int32_t c) {
   // Sorted (three compare-exchanges).
   if (a > b) std::swap(a, b);
@@ -52,6 +116,11 @@ FaceKey makeFace(std::int32_t a, std::int32_t b, std::int32_t c) {
 // Outward faces of a positive tet, by the local index of the opposite vertex.
 constexpr int kFace[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
 constexpr int kEdge[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
+// The three faces of a tet containing its vertex k, each by its two other vertices.
+constexpr int kFacePairs[4][3][2] = {{{2, 3}, {1, 3}, {1, 2}},
+                                     {{2, 3}, {0, 3}, {0, 2}},
+                                     {{1, 3}, {0, 3}, {0, 1}},
+                                     {{1, 2}, {0, 2}, {0, 1}}};
 
 double signedVolume(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
   return (b - a).dot((c - a).cross(d - a)) / 6.0;
@@ -83,41 +152,77 @@ std::vector<EndCandidate> endCandidates(const std::vector<CrossedEdge>& crossed,
   return out;
 }
 
-// Working mesh: the input arrays plus appended nodes and tets.
+// Working mesh: row-major copies of the input arrays (a node's or a tet's entries in one
+// place, which the local passes below read over and over) plus appended nodes and tets.
+// The output mesh is written once from them (Assemble).
 struct Work {
-  const TetMesh& in;
-  Positions& X0;                  // the output copy's original rows (may move)
-  Tets& T0;
-  std::vector<Vec3> extraX;       // appended nodes
-  std::vector<Tet> extraT;        // appended tets
-  std::vector<std::int32_t> extraMat;
+  std::vector<Vec3> X;             // #nodes: input rows (may move), then appended nodes
+  std::vector<Tet> T;              // #tets: input rows (modified in place), then appended tets
+  std::vector<std::int32_t> extraMat;  // material of the appended tets
   int N0, M0;
 
-  Work(const TetMesh& input, TetMesh& out) : in(input), X0(out.X), T0(out.T), N0(input.numNodes()), M0(input.numTets()) {}
-  int numNodes() const { return N0 + static_cast<int>(extraX.size()); }
-  int numTets() const { return M0 + static_cast<int>(extraT.size()); }
-  Vec3 x(int i) const { return i < N0 ? Vec3(X0.row(i).transpose()) : extraX[i - N0]; }
-  Tet tet(int t) const {
-    if (t < M0) return {T0(t, 0), T0(t, 1), T0(t, 2), T0(t, 3)};
-    return extraT[t - M0];
+  Work(const TetMesh& input, size_t extraNodes, size_t extraTets) : N0(input.numNodes()), M0(input.numTets()) {
+    X.reserve(N0 + extraNodes);
+    T.reserve(M0 + extraTets);
+    extraMat.reserve(extraTets);
+    X.resize(N0);
+    const double* c[3] = {input.X.col(0).data(), input.X.col(1).data(), input.X.col(2).data()};
+    for (int i = 0; i < N0; ++i) X[i] = Vec3(c[0][i], c[1][i], c[2][i]);
+    T.resize(M0);
+    const std::int32_t* d[4] = {input.T.col(0).data(), input.T.col(1).data(), input.T.col(2).data(),
+                                input.T.col(3).data()};
+    for (int t = 0; t < M0; ++t) T[t] = {d[0][t], d[1][t], d[2][t], d[3][t]};
   }
+  int numNodes() const { return static_cast<int>(X.size()); }
+  int numTets() const { return static_cast<int>(T.size()); }
+  const Vec3& x(int i) const { return X[i]; }
+  const Tet& tet(int t) const { return T[t]; }
+  std::vector<std::int32_t> changedNodes, changedTets;  // input rows written (may repeat)
   void setTet(int t, const Tet& v) {
-    if (t < M0) {
-      for (int k = 0; k < 4; ++k) T0(t, k) = v[k];
-    } else {
-      extraT[t - M0] = v;
-    }
+    T[t] = v;
+    if (t < M0) changedTets.push_back(t);
   }
-  int addTet(const Tet& v, std::int32_t material) {
-    extraT.push_back(v);
+  void setX(int i, const Vec3& p) {
+    X[i] = p;
+    if (i < N0) changedNodes.push_back(i);
+  }
+  int addTet(Tet v, std::int32_t material) {
+    T.push_back(v);
     extraMat.push_back(material);
     return numTets() - 1;
   }
-  int addNode(const Vec3& p) {
-    extraX.push_back(p);
+  int addNode(Vec3 p) {
+    X.push_back(p);
     return numNodes() - 1;
   }
 };
+
+// Quick test for the usual case, an interior node: is every face containing n shared by an
+// even number of n's tets? XOR of a 64-bit hash of each face (by its other two nodes) over
+// the star: zero when every face occurs an even number of times; a face used once (a
+// boundary face; there are at least three around a boundary node) leaves a random non-zero
+// value (zero only with probability 2^-64). Branch-free over the six edges of each tet.
+inline std::uint64_t mix64(std::uint64_t x) {
+  x ^= x >> 30;
+  x *= 0xBF58476D1CE4E5B9ull;
+  x ^= x >> 27;
+  x *= 0x94D049BB133111EBull;
+  return x ^ (x >> 31);
+}
+template <class W>
+bool evenFacePairs(const W& w, int n, const std::vector<std::int32_t>& starOff, const std::vector<std::int32_t>& starTet) {
+  std::uint64_t acc = 0;
+  for (int s = starOff[n]; s < starOff[n + 1]; ++s) {
+    const auto& tv = w.tet(starTet[s]);
+    for (const auto& e : kEdge) {
+      const std::uint32_t a = static_cast<std::uint32_t>(tv[e[0]]), b = static_cast<std::uint32_t>(tv[e[1]]);
+      const std::uint64_t key = (static_cast<std::uint64_t>(std::min(a, b)) << 32) | std::max(a, b);
+      const std::uint64_t keep = (tv[e[0]] != n && tv[e[1]] != n) ? ~0ull : 0ull;
+      acc ^= mix64(key) & keep;
+    }
+  }
+  return acc == 0;
+}
 
 int findLocal(const Tet& t, int v) {
   for (int k = 0; k < 4; ++k)
@@ -138,20 +243,19 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
   const int N0 = input.numNodes(), M0 = input.numTets();
   if (M0 == 0 || N0 == 0) return Error{"cut3d: empty mesh"};
   if (input.material.size() != 0 && input.material.size() != M0) return Error{"cut3d: material size differs from #T"};
-  for (int t = 0; t < M0; ++t)
-    for (int k = 0; k < 4; ++k)
-      if (input.T(t, k) < 0 || input.T(t, k) >= N0)
-        return Error{"cut3d: tet " + std::to_string(t) + " has a node index out of range"};
+  if (input.T.minCoeff() < 0 || input.T.maxCoeff() >= N0)
+    for (int t = 0; t < M0; ++t)
+      for (int k = 0; k < 4; ++k)
+        if (input.T(t, k) < 0 || input.T(t, k) >= N0)
+          return Error{"cut3d: tet " + std::to_string(t) + " has a node index out of range"};
   if (!input.X.allFinite()) return Error{"cut3d: non-finite node coordinates"};
   if (!(options.snap_region >= 0 && options.snap_region <= 0.5)) return Error{"cut3d: snap_region must be in [0, 0.5]"};
 
   Cut3DResult result;
-  TetMesh& out = result.mesh;
-  out = input;
-  if (out.material.size() == 0) out.material = Labels::Zero(M0);
+  TetMesh& out = result.mesh;  // written at Assemble
   Cut3DReport& report = result.report;
   TopologyChange& change = result.change;
-  Work w(input, out);
+  auto materialOf = [&](int t) { return input.material.size() != 0 ? input.material(t) : 0; };
 
   const Vec3 lo = input.X.colwise().minCoeff().transpose(), hi = input.X.colwise().maxCoeff().transpose();
   const double diag = (hi - lo).norm();
@@ -159,68 +263,73 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
   const double eps = options.on_surface_tolerance * diag;
   const bool plane = surface.isPlane();
 
-  // Node -> tets (CSR) of the input mesh.
-  std::vector<std::int32_t> starOff(N0 + 1, 0), starTet(4 * static_cast<size_t>(M0));
-  for (int t = 0; t < M0; ++t)
-    for (int k = 0; k < 4; ++k) ++starOff[input.T(t, k) + 1];
-  for (int i = 0; i < N0; ++i) starOff[i + 1] += starOff[i];
-  {
-    std::vector<std::int32_t> fill(starOff.begin(), starOff.end() - 1);
-    for (int t = 0; t < M0; ++t)
-      for (int k = 0; k < 4; ++k) starTet[fill[input.T(t, k)]++] = t;
-  }
-
   // 1. Classification. side: +1 / -1 strictly off the surface (where known), 0 on it or unknown.
   std::vector<double> phi;            // plane: signed distances
   std::vector<std::uint8_t> on;       // on the surface (grows with new nodes)
   on.assign(N0, 0);
   std::vector<CrossedEdge> crossed;
   std::vector<Vec3> crossedNormal;    // surface: normal of the hit triangle per crossed edge
-  std::unordered_map<std::uint64_t, std::int32_t> edgeIndex;  // crossed edge -> index
+  EdgeMap edgeIndex(kNoEdge);  // crossed edge -> index
   std::vector<std::int32_t> crossedTets;
   std::vector<std::int32_t> onNodes;  // original nodes on the surface
   if (plane) {
     phi.resize(N0);
     const Vec3 n = surface.planeNormal(), p = surface.planePoint();
+    // Per node: 1 strictly on the positive side, 2 strictly on the negative side.
+    std::vector<std::uint8_t> sideBits(N0);
     for (int i = 0; i < N0; ++i) {
       phi[i] = n.dot(input.X.row(i).transpose() - p);
+      sideBits[i] = static_cast<std::uint8_t>((phi[i] > eps ? 1 : 0) | (phi[i] < -eps ? 2 : 0));
       if (std::abs(phi[i]) <= eps) {
         on[i] = 1;
         onNodes.push_back(i);
       }
     }
+    const std::int32_t* T0c[4] = {input.T.col(0).data(), input.T.col(1).data(), input.T.col(2).data(),
+                                  input.T.col(3).data()};
     for (int t = 0; t < M0; ++t) {
-      bool pos = false, neg = false;
-      for (int k = 0; k < 4; ++k) {
-        const double f = phi[input.T(t, k)];
-        pos = pos || f > eps;
-        neg = neg || f < -eps;
-      }
-      if (!(pos && neg)) continue;
+      if ((sideBits[T0c[0][t]] | sideBits[T0c[1][t]] | sideBits[T0c[2][t]] | sideBits[T0c[3][t]]) != 3) continue;
       crossedTets.push_back(t);
       for (const auto& e : kEdge) {
         const int a = input.T(t, e[0]), b = input.T(t, e[1]);
         if (!((phi[a] > eps && phi[b] < -eps) || (phi[a] < -eps && phi[b] > eps))) continue;
         const auto key = edgeKey(a, b);
-        if (edgeIndex.count(key)) continue;
+        if (!edgeIndex.tryEmplace(key, static_cast<std::int32_t>(crossed.size())).second) continue;
         const int lo_ = std::min(a, b), hi_ = std::max(a, b);
         const double tt = phi[lo_] / (phi[lo_] - phi[hi_]);
-        edgeIndex.emplace(key, static_cast<std::int32_t>(crossed.size()));
         crossed.push_back({lo_, hi_, tt, Vec3::Zero(), true});
       }
     }
   } else {
     std::vector<std::uint8_t> seen(N0, 0);
-    std::unordered_set<std::uint64_t> tested;
+    FlatMap<std::uint64_t, std::uint8_t, EdgeKeyHash> tested(kNoEdge);
+    // Outcodes against the surface's box grown by 2 eps (bit per side and axis): a tet whose
+    // nodes share a bit lies beside that box, which is what mayTouch tests first.
+    std::vector<std::uint8_t> outcode(N0);
+    {
+      const Eigen::Array3d blo = surface.bounds().min().array() - 2 * eps, bhi = surface.bounds().max().array() + 2 * eps;
+      for (int i = 0; i < N0; ++i) {
+        std::uint8_t c = 0;
+        for (int d = 0; d < 3; ++d) {
+          const double x = input.X(i, d);
+          c |= static_cast<std::uint8_t>((x < blo[d] ? 1 : 0) << (2 * d));
+          c |= static_cast<std::uint8_t>((x > bhi[d] ? 1 : 0) << (2 * d + 1));
+        }
+        outcode[i] = c;
+      }
+    }
     for (int t = 0; t < M0; ++t) {
+      if (outcode[input.T(t, 0)] & outcode[input.T(t, 1)] & outcode[input.T(t, 2)] & outcode[input.T(t, 3)]) continue;
       Eigen::AlignedBox3d box;
       for (int k = 0; k < 4; ++k) box.extend(input.X.row(input.T(t, k)).transpose());
-      if (!surface.mayTouch(box, eps)) continue;
+      // Tets away from every leaf of the surface's tree have no node on it and no crossed
+      // edge (the margin 2 eps only adds tets, which then find nothing).
+      if (!surface.mayTouch(box, 2 * eps)) continue;
       for (int k = 0; k < 4; ++k) {
         const int v = input.T(t, k);
         if (seen[v]) continue;
         seen[v] = 1;
-        if (std::abs(surface.signedDistance(input.X.row(v).transpose())) <= eps) {
+        if (surface.within(input.X.row(v).transpose(), eps)) {
           on[v] = 1;
           onNodes.push_back(v);
         }
@@ -230,14 +339,14 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
         const int a = std::min(input.T(t, e[0]), input.T(t, e[1]));
         const int b = std::max(input.T(t, e[0]), input.T(t, e[1]));
         const auto key = edgeKey(a, b);
-        if (edgeIndex.count(key)) {
+        if (edgeIndex.contains(key)) {
           any = true;
           continue;
         }
-        if (on[a] || on[b] || !tested.insert(key).second) continue;
+        if (on[a] || on[b] || !tested.tryEmplace(key, 1).second) continue;
         CutSurface::Hit hit;
         if (!surface.intersectSegment(input.X.row(a).transpose(), input.X.row(b).transpose(), eps, &hit)) continue;
-        edgeIndex.emplace(key, static_cast<std::int32_t>(crossed.size()));
+        edgeIndex.tryEmplace(key, static_cast<std::int32_t>(crossed.size()));
         crossed.push_back({a, b, hit.t, hit.point, true});
         crossedNormal.push_back(hit.normal);
         any = true;
@@ -248,6 +357,52 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
   }
   report.crossed_edges = static_cast<int>(crossed.size());
   report.crossed_elements = static_cast<int>(crossedTets.size());
+  // Ends of crossed edges: an edge whose ends are not both marked is not in edgeIndex.
+  std::vector<std::uint8_t> crossEnd(N0, 0);
+  for (const auto& ce : crossed) crossEnd[ce.a] = crossEnd[ce.b] = 1;
+  // Room for what the cut appends (split nodes and their tets, copies), so that the working
+  // arrays are not copied as they grow (a guess; they still grow past it if needed).
+  Work w(input, 4 * crossed.size() + 64, 12 * crossed.size() + 64);
+
+  // Node -> tets (CSR) of the input mesh, complete (all tets, ascending) for the nodes within
+  // one edge step of the crossed tets and the nodes on the surface: the only stars the steps
+  // below look at (snap/away/route candidates are ends of crossed edges, feature tests look
+  // at their neighbours, subdivision and separation at the crossed tets and the nodes on the
+  // cut). Two passes over the tets mark those nodes and the tets around them.
+  std::vector<std::int32_t> starOff(N0 + 1, 0), starTet;
+  {
+    std::vector<std::uint8_t> near(N0, 0);
+    for (int t : crossedTets)
+      for (int k = 0; k < 4; ++k) near[input.T(t, k)] = 1;
+    for (int n : onNodes) near[n] = 1;
+    const std::int32_t* T0c[4] = {input.T.col(0).data(), input.T.col(1).data(), input.T.col(2).data(),
+                                  input.T.col(3).data()};
+    for (int t = 0; t < M0; ++t) {
+      const int a = T0c[0][t], b = T0c[1][t], c = T0c[2][t], d = T0c[3][t];
+      if ((near[a] | near[b] | near[c] | near[d]) & 1) {
+        near[a] |= 2;
+        near[b] |= 2;
+        near[c] |= 2;
+        near[d] |= 2;
+      }
+    }
+    std::vector<std::int32_t> around;  // tets with a node marked (either flag)
+    for (int t = 0; t < M0; ++t) {
+      const int a = T0c[0][t], b = T0c[1][t], c = T0c[2][t], d = T0c[3][t];
+      if (near[a] | near[b] | near[c] | near[d]) {
+        around.push_back(t);
+        ++starOff[a + 1];
+        ++starOff[b + 1];
+        ++starOff[c + 1];
+        ++starOff[d + 1];
+      }
+    }
+    for (int i = 0; i < N0; ++i) starOff[i + 1] += starOff[i];
+    starTet.resize(starOff[N0]);
+    std::vector<std::int32_t> fill(starOff.begin(), starOff.end() - 1);
+    for (int t : around)
+      for (int k = 0; k < 4; ++k) starTet[fill[T0c[k][t]]++] = t;
+  }
 
   auto crossingPoint = [&](const CrossedEdge& e) -> Vec3 {
     if (!plane) return e.point;
@@ -262,10 +417,14 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
   // Moving node n to `target` keeps every tet of its star positive, not flat and not badly
   // degraded (q* below min(before, min_quality)), and every edge of n at least
   // min_edge_fraction of its length.
+  // (The conditions are independent, so they are tested cheapest first, and each edge of n
+  // once although several tets share it.)
+  std::vector<std::uint8_t> guardSeen(N0, 0);
+  std::vector<std::int32_t> guardNbrs;
   auto guardOk = [&](int n, const Vec3& target) {
     const Vec3 old = w.x(n);
     for (int s = starOff[n]; s < starOff[n + 1]; ++s) {
-      const Tet tv = w.tet(starTet[s]);
+      const Tet& tv = w.tet(starTet[s]);
       Vec3 p[4], q[4];
       for (int k = 0; k < 4; ++k) {
         p[k] = w.x(tv[k]);
@@ -274,12 +433,31 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
       const double v0 = signedVolume(p[0], p[1], p[2], p[3]);
       const double v1 = signedVolume(q[0], q[1], q[2], q[3]);
       if (!(v1 > 1e-3 * v0)) return false;
+    }
+    guardNbrs.clear();
+    bool ok = true;
+    for (int s = starOff[n]; s < starOff[n + 1] && ok; ++s)
+      for (const int v : w.tet(starTet[s])) {
+        if (v == n || guardSeen[v]) continue;
+        guardSeen[v] = 1;
+        guardNbrs.push_back(v);
+        const Vec3& pv = w.x(v);
+        if ((pv - target).norm() < options.min_edge_fraction * (pv - old).norm()) {
+          ok = false;
+          break;
+        }
+      }
+    for (const int v : guardNbrs) guardSeen[v] = 0;
+    if (!ok) return false;
+    for (int s = starOff[n]; s < starOff[n + 1]; ++s) {
+      const Tet& tv = w.tet(starTet[s]);
+      Vec3 p[4], q[4];
+      for (int k = 0; k < 4; ++k) {
+        p[k] = w.x(tv[k]);
+        q[k] = tv[k] == n ? target : p[k];
+      }
       const double qa = radiusRatio(q[0], q[1], q[2], q[3]);
       if (qa < options.min_quality && qa < radiusRatio(p[0], p[1], p[2], p[3])) return false;
-      for (int k = 0; k < 4; ++k) {
-        if (tv[k] == n) continue;
-        if ((q[k] - target).norm() < options.min_edge_fraction * (p[k] - old).norm()) return false;
-      }
     }
     return true;
   };
@@ -304,6 +482,10 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
   std::vector<Seen> seenFaces;
   std::vector<std::int32_t> bfNbrs, bfLocal(N0, -1), faceAt;
   auto boundaryFacesOf = [&](int n) {
+    if (bfStart[n] < 0 && evenFacePairs(w, n, starOff, starTet)) {
+      bfStart[n] = static_cast<std::int32_t>(bfPool.size());  // interior: no boundary face
+      bfCount[n] = 0;
+    }
     if (bfStart[n] < 0) {
       seenFaces.clear();
       // Local numbers of n's neighbours; faceAt: (pair of them) -> index in seenFaces.
@@ -315,7 +497,7 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
             bfNbrs.push_back(v);
           }
       const size_t L = bfNbrs.size();
-      faceAt.assign(L * L, -1);
+      if (faceAt.size() < L * L) faceAt.resize(L * L, -1);  // all -1 between calls
       for (int s = starOff[n]; s < starOff[n + 1]; ++s) {
         const Tet tv = w.tet(starTet[s]);
         const int ln = findLocal(tv, n);
@@ -335,6 +517,10 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
             seenFaces.push_back({o[0], o[1], i0, i1, i2, 1});
           }
         }
+      }
+      for (const auto& q : seenFaces) {
+        const std::int32_t a = bfLocal[q.u], b = bfLocal[q.v];
+        faceAt[std::min(a, b) * L + std::max(a, b)] = -1;
       }
       for (int v : bfNbrs) bfLocal[v] = -1;
       bfStart[n] = static_cast<std::int32_t>(bfPool.size());
@@ -436,9 +622,9 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
             const auto fe = featureEdgesOf(n);
             const double reach = fe.straight ? region : fe.polyhedral ? 0.0 : std::min(region, options.feature_slide_fraction);
             for (int r : fe.to) {
-              const auto it = edgeIndex.find(edgeKey(n, r));
-              if (it == edgeIndex.end()) continue;
-              const CrossedEdge& re = crossed[it->second];
+              const std::int32_t* it = edgeIndex.find(edgeKey(n, r));
+              if (!it) continue;
+              const CrossedEdge& re = crossed[*it];
               if (!re.alive || (re.a == n ? re.t : 1.0 - re.t) > reach) continue;
               target = crossingPoint(re);
               slid = true;
@@ -465,7 +651,7 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
           }
           target = w.x(n) - (dist / slope) * d;
           // A curved surface: the hit triangle's plane is only good where it is the surface.
-          if (!plane && std::abs(surface.signedDistance(target)) > 10 * eps) {
+          if (!plane && !surface.within(target, 10 * eps)) {
             ++report.feature_skips;
             continue;
           }
@@ -487,7 +673,7 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
         refused[n] = 1;
         continue;
       }
-      w.X0.row(n) = target.transpose();
+      w.setX(n, target);
       on[n] = 1;
       if (plane) phi[n] = 0;
       onNodes.push_back(n);
@@ -498,9 +684,9 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
       for (int s = starOff[n]; s < starOff[n + 1]; ++s) {
         const Tet tv = w.tet(starTet[s]);
         for (int k = 0; k < 4; ++k) {
-          if (tv[k] == n) continue;
-          const auto it = edgeIndex.find(edgeKey(n, tv[k]));
-          if (it != edgeIndex.end()) crossed[it->second].alive = false;
+          if (tv[k] == n || !crossEnd[tv[k]]) continue;
+          const std::int32_t* it = edgeIndex.find(edgeKey(n, tv[k]));
+          if (it) crossed[*it].alive = false;
         }
       }
     }
@@ -536,9 +722,9 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
       for (int s = starOff[n]; s < starOff[n + 1]; ++s) {
         const Tet tv = w.tet(starTet[s]);
         for (int k = 0; k < 4; ++k) {
-          if (tv[k] == n) continue;
-          const auto it = edgeIndex.find(edgeKey(n, tv[k]));
-          if (it == edgeIndex.end() || !crossed[it->second].alive) continue;
+          if (tv[k] == n || !crossEnd[tv[k]]) continue;
+          const std::int32_t* it = edgeIndex.find(edgeKey(n, tv[k]));
+          if (!it || !crossed[*it].alive) continue;
           need = std::max(need, f / (1.0 - f) * std::abs(phi[tv[k]]));
         }
       }
@@ -588,15 +774,15 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
         if (step > maxStep) continue;
         const Vec3 target = w.x(n) + step * dir;
         if (!guardOk(n, target)) continue;
-        w.X0.row(n) = target.transpose();
+        w.setX(n, target);
         phi[n] = pn.dot(target - pp);
         for (int s = starOff[n]; s < starOff[n + 1]; ++s) {
           const Tet tv = w.tet(starTet[s]);
           for (int k = 0; k < 4; ++k) {
-            if (tv[k] == n) continue;
-            const auto it = edgeIndex.find(edgeKey(n, tv[k]));
-            if (it == edgeIndex.end()) continue;
-            CrossedEdge& ce = crossed[it->second];
+            if (tv[k] == n || !crossEnd[tv[k]]) continue;
+            const std::int32_t* it = edgeIndex.find(edgeKey(n, tv[k]));
+            if (!it) continue;
+            CrossedEdge& ce = crossed[*it];
             ce.t = phi[ce.a] / (phi[ce.a] - phi[ce.b]);
           }
         }
@@ -627,12 +813,12 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
       for (int s = starOff[n]; s < starOff[n + 1]; ++s) {
         const Tet tv = w.tet(starTet[s]);
         for (int k = 0; k < 4; ++k) {
-          if (tv[k] == n) continue;
+          if (tv[k] == n || !crossEnd[tv[k]]) continue;
           // Edges crossed nearer n than their other end now end on the cut; the others
           // (crossed nearer the other end, which may itself be routed through) stay split.
-          const auto it = edgeIndex.find(edgeKey(n, tv[k]));
-          if (it == edgeIndex.end()) continue;
-          CrossedEdge& ce = crossed[it->second];
+          const std::int32_t* it = edgeIndex.find(edgeKey(n, tv[k]));
+          if (!it) continue;
+          CrossedEdge& ce = crossed[*it];
           if ((ce.a == n ? ce.t : 1.0 - ce.t) <= 0.5) ce.alive = false;
         }
       }
@@ -693,7 +879,7 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
           tv[lb] = pn;
           other[la] = pn;
           w.setTet(t, tv);
-          list.push_back(w.addTet(other, out.material(o)));
+          list.push_back(w.addTet(other, materialOf(o)));
         }
       }
     }
@@ -703,8 +889,8 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
   // 4. Separation. Local tets: the current stars of all nodes on the cut.
   auto isDeleted = [&](int t) { return deleting && t < M0 && deleted[t]; };
   std::vector<std::int32_t> local;
+  std::vector<std::uint8_t> inLocal(w.numTets(), 0);
   {
-    std::vector<std::uint8_t> inLocal(w.numTets(), 0);
     auto add = [&](int t) {
       if (!inLocal[t] && !isDeleted(t)) {
         inLocal[t] = 1;
@@ -728,14 +914,14 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
     std::int8_t opposite[2];
     int count = 0;
   };
-  std::unordered_map<FaceKey, FaceUse, FaceKeyHash> onFaces;
+  FlatMap<FaceKey, FaceUse, FaceFlatHash> onFaces(kNoFace);
   if (options.separate) {
     for (int t : local) {
       const Tet tv = w.tet(t);
       for (int f = 0; f < 4; ++f) {
         const int i0 = tv[kFace[f][0]], i1 = tv[kFace[f][1]], i2 = tv[kFace[f][2]];
         if (!on[i0] || !on[i1] || !on[i2]) continue;
-        FaceUse& u = onFaces[makeFace(i0, i1, i2)];
+        FaceUse& u = *onFaces.tryEmplace(makeFace(i0, i1, i2), FaceUse{}).first;
         if (u.count < 2) {
           u.tet[u.count] = t;
           u.opposite[u.count] = static_cast<std::int8_t>(f);
@@ -744,7 +930,8 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
       }
     }
   }
-  std::unordered_set<FaceKey, FaceKeyHash> cutFaces;
+  FlatMap<FaceKey, std::uint8_t, FaceFlatHash> cutFaces(kNoFace);
+  std::vector<std::pair<FaceKey, FaceUse>> cutFaceList;
   std::vector<std::pair<std::int32_t, std::int8_t>> cutFaceSides;  // (tet, opposite local vertex)
   // Side of a tet at a face on the cut: the signed distance of the vertex opposite the face
   // (a node treated as on the surface without moving keeps its own small distance).
@@ -760,17 +947,17 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
     }
     return off != 0 ? off : routed;
   };
-  for (const auto& [key, use] : onFaces) {
-    if (use.count != 2) continue;
+  onFaces.forEach([&](const FaceKey& key, const FaceUse& use) {
+    if (use.count != 2) return;
     // Only a face between the two sides is cut (with through-node approximation, a face of
     // on-nodes may have both its tets on one side).
-    if (!approx.empty() && !(sideOf(use.tet[0], use.opposite[0]) * sideOf(use.tet[1], use.opposite[1]) < 0)) continue;
+    if (!approx.empty() && !(sideOf(use.tet[0], use.opposite[0]) * sideOf(use.tet[1], use.opposite[1]) < 0)) return;
     if (!plane) {
       // The face must lie in the surface, not just have its corners on it.
       const Vec3 a = w.x(key.v[0]), b = w.x(key.v[1]), c = w.x(key.v[2]);
       const double size = std::max({(b - a).norm(), (c - a).norm(), (c - b).norm()});
       const Vec3 centre = (a + b + c) / 3.0;
-      if (std::abs(surface.signedDistance(centre)) > eps + 0.05 * size) {
+      if (!surface.within(centre, eps + 0.05 * size)) {
         // On a curved surface a flat face with its corners on the surface lies off it by the
         // sagitta (about size^2 / (8 R)), and a thin tet beside it may lie wholly on the far
         // side of the surface. The face is still on the cut when the surface passes between
@@ -789,16 +976,15 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
         const int o0 = w.tet(use.tet[0])[use.opposite[0]], o1 = w.tet(use.tet[1])[use.opposite[1]];
         const bool across = (!on[o0] && !on[o1] && crossesNear(w.x(o0), w.x(o1))) ||
                             crossesNear(centroid(use.tet[0]), centroid(use.tet[1]));
-        if (!across) continue;
+        if (!across) return;
       }
     }
-    cutFaces.insert(key);
-  }
+    cutFaces.tryEmplace(key, 1);
+    cutFaceList.emplace_back(key, use);
+  });
   // Deterministic order for the side records.
-  std::vector<FaceKey> cutFaceList(cutFaces.begin(), cutFaces.end());
-  std::sort(cutFaceList.begin(), cutFaceList.end(), [](const FaceKey& x, const FaceKey& y) { return x.v < y.v; });
-  for (const auto& key : cutFaceList) {
-    const auto& use = onFaces[key];
+  std::sort(cutFaceList.begin(), cutFaceList.end(), [](const auto& x, const auto& y) { return x.first.v < y.first.v; });
+  for (const auto& [key, use] : cutFaceList) {
     cutFaceSides.emplace_back(use.tet[0], use.opposite[0]);
     cutFaceSides.emplace_back(use.tet[1], use.opposite[1]);
   }
@@ -807,24 +993,35 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
   std::vector<std::int32_t> cutNodes;
   if (!cutFaceList.empty()) {
     for (const auto& key : cutFaceList)
-      for (int v : key.v) cutNodes.push_back(v);
+      for (int v : key.first.v) cutNodes.push_back(v);
     std::sort(cutNodes.begin(), cutNodes.end());
     cutNodes.erase(std::unique(cutNodes.begin(), cutNodes.end()), cutNodes.end());
     std::vector<std::int32_t> slot(w.numNodes(), -1);
     for (size_t i = 0; i < cutNodes.size(); ++i) slot[cutNodes[i]] = static_cast<std::int32_t>(i);
-    std::vector<std::vector<std::int32_t>> star(cutNodes.size());
-    for (int t : local) {
-      const Tet tv = w.tet(t);
-      for (int k = 0; k < 4; ++k)
-        if (slot[tv[k]] >= 0) star[slot[tv[k]]].push_back(t);
-    }
+    // Stars of the cut nodes within the local tets (CSR, each ascending: filled from the
+    // local tets in ascending order).
     const size_t numCut = cutNodes.size();
-    std::vector<int> parent;
-    std::vector<std::int32_t> sepLocal, sepNbrs, firstTet;
+    std::vector<std::int32_t> cutStarOff(numCut + 1, 0), cutStarTet, localSorted;
+    localSorted.reserve(local.size());
+    for (int t = 0; t < static_cast<int>(inLocal.size()); ++t)
+      if (inLocal[t]) localSorted.push_back(t);
+    for (int t : localSorted)
+      for (const int v : w.tet(t))
+        if (slot[v] >= 0) ++cutStarOff[slot[v] + 1];
+    for (size_t i = 0; i < numCut; ++i) cutStarOff[i + 1] += cutStarOff[i];
+    cutStarTet.resize(cutStarOff[numCut]);
+    {
+      std::vector<std::int32_t> fill(cutStarOff.begin(), cutStarOff.end() - 1);
+      for (int t : localSorted)
+        for (const int v : w.tet(t))
+          if (slot[v] >= 0) cutStarTet[fill[slot[v]]++] = t;
+    }
+    std::vector<int> parent, copyOf;
+    std::vector<std::int32_t> sepLocal, sepNbrs, firstTet, firstUsed;
+    std::vector<std::array<std::int32_t, 4>> facePairs;  // first tet, tet, the face's other two nodes
     for (size_t i = 0; i < numCut; ++i) {
       const int n = cutNodes[i];
-      auto& st = star[i];
-      std::sort(st.begin(), st.end());
+      const std::span<std::int32_t> st(cutStarTet.data() + cutStarOff[i], cutStarTet.data() + cutStarOff[i + 1]);
       parent.resize(st.size());
       std::iota(parent.begin(), parent.end(), 0);
       auto find = [&](int x) {
@@ -842,27 +1039,35 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
             sepNbrs.push_back(v);
           }
       const size_t L = sepNbrs.size();
-      firstTet.assign(L * L, -1);
-      for (size_t j = 0; j < st.size(); ++j) {
-        const Tet tv = w.tet(st[j]);
+      if (firstTet.size() < L * L) firstTet.resize(L * L, -1);  // all -1 between nodes
+      // Pass 1 (without data-dependent branches): each face occurrence after the first
+      // gives a pair (first tet, this tet). Pass 2: pairs not across a cut face are joined.
+      firstUsed.resize(3 * st.size());
+      facePairs.resize(3 * st.size());
+      size_t numPairs = 0;
+      for (size_t j = 0, q = 0; j < st.size(); ++j) {
+        const Tet& tv = w.tet(st[j]);
         const int ln = findLocal(tv, n);
-        for (int f = 0; f < 4; ++f) {
-          if (f == ln) continue;
-          std::int32_t o[2], m = 0;
-          for (int k = 0; k < 3; ++k)
-            if (tv[kFace[f][k]] != n) o[m++] = tv[kFace[f][k]];
-          const std::int32_t a = sepLocal[o[0]], b = sepLocal[o[1]];
-          std::int32_t& first = firstTet[std::min(a, b) * L + std::max(a, b)];
-          if (first < 0) {
-            first = static_cast<std::int32_t>(j);
-          } else if (!cutFaces.count(makeFace(n, o[0], o[1]))) {
-            parent[find(first)] = find(static_cast<int>(j));
-          }
+        for (const auto& pair : kFacePairs[ln]) {
+          const std::int32_t o0 = tv[pair[0]], o1 = tv[pair[1]];
+          const std::int32_t a = sepLocal[o0], b = sepLocal[o1];
+          const std::int32_t at = static_cast<std::int32_t>(std::min(a, b) * L + std::max(a, b));
+          const std::int32_t first = firstTet[at];
+          firstTet[at] = first < 0 ? static_cast<std::int32_t>(j) : first;
+          firstUsed[q++] = at;
+          facePairs[numPairs] = {first, static_cast<std::int32_t>(j), o0, o1};
+          numPairs += first >= 0 ? 1 : 0;
         }
       }
       for (int v : sepNbrs) sepLocal[v] = -1;
+      for (const std::int32_t at : firstUsed) firstTet[at] = -1;
+      for (size_t q = 0; q < numPairs; ++q) {
+        const auto& [first, j, o0, o1] = facePairs[q];
+        // (Every cut face has its three nodes on the cut, so most faces need no lookup.)
+        if (!(on[o0] && on[o1]) || !cutFaces.contains(makeFace(n, o0, o1))) parent[find(first)] = find(j);
+      }
       // The group of the first tet keeps n; every other group gets a copy.
-      std::vector<int> copyOf(st.size(), -1);
+      copyOf.assign(st.size(), -1);
       const int keep = find(0);
       for (size_t j = 0; j < st.size(); ++j) {
         const int g = find(static_cast<int>(j));
@@ -902,14 +1107,27 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
 
   // Assemble.
   const int N1 = w.numNodes(), M1 = w.numTets();
-  out.X.conservativeResize(N1, 3);
-  for (int i = N0; i < N1; ++i) out.X.row(i) = w.extraX[i - N0].transpose();
-  out.T.conservativeResize(M1, 4);
-  out.material.conservativeResize(M1);
-  for (int t = M0; t < M1; ++t) {
-    for (int k = 0; k < 4; ++k) out.T(t, k) = w.extraT[t - M0][k];
-    out.material(t) = w.extraMat[t - M0];
+  // The input arrays (column copies), the rows the cut wrote, then the appended rows.
+  out.X.resize(N1, 3);
+  out.X.topRows(N0) = input.X;
+  for (const int i : w.changedNodes) out.X.row(i) = w.X[i].transpose();
+  for (int i = N0; i < N1; ++i) out.X.row(i) = w.X[i].transpose();
+  out.T.resize(M1, 4);
+  out.T.topRows(M0) = input.T;
+  {
+    std::int32_t* d[4] = {out.T.col(0).data(), out.T.col(1).data(), out.T.col(2).data(), out.T.col(3).data()};
+    for (const int t : w.changedTets)
+      for (int k = 0; k < 4; ++k) d[k][t] = w.T[t][k];
+    for (int t = M0; t < M1; ++t)
+      for (int k = 0; k < 4; ++k) d[k][t] = w.T[t][k];
   }
+  out.material.resize(M1);
+  if (input.material.size() != 0) {
+    out.material.head(M0) = input.material;
+  } else {
+    out.material.head(M0).setZero();
+  }
+  for (int t = M0; t < M1; ++t) out.material(t) = w.extraMat[t - M0];
 
   change.old_num_nodes = N0;
   change.old_num_elements = M0;
@@ -966,26 +1184,53 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
   if (deleting || anyPeeled) {
     // Compact: drop deleted and peeled tets and the nodes no longer used.
     auto dropped = [&](int t) { return (t < M0 && deleting && deleted[t]) || (anyPeeled && peeled[t]); };
-    std::vector<std::int32_t> tetMap(M1, -1), nodeMap(N1, -1);
+    std::vector<std::int32_t> tetMap(M1, -1), nodeMap(N1, -1), drop;
     int mt = 0;
-    for (int t = 0; t < M1; ++t)
-      if (!dropped(t)) tetMap[t] = mt++;
-    for (int t = 0; t < M1; ++t)
-      if (tetMap[t] >= 0)
-        for (int k = 0; k < 4; ++k) nodeMap[out.T(t, k)] = 1;
+    for (int t = 0; t < M1; ++t) {
+      if (!dropped(t)) {
+        tetMap[t] = mt++;
+      } else {
+        drop.push_back(t);
+      }
+    }
+    // Uses of each node by the kept tets (all uses minus those of the dropped tets): a node
+    // no kept tet uses goes.
+    for (int k = 0; k < 4; ++k) {
+      const std::int32_t* col = out.T.col(k).data();
+      for (int t = 0; t < M1; ++t) ++nodeMap[col[t]];  // from -1: uses - 1
+    }
+    for (int t : drop)
+      for (int k = 0; k < 4; ++k) --nodeMap[out.T(t, k)];
     int mn = 0;
-    for (int i = 0; i < N1; ++i) nodeMap[i] = nodeMap[i] > 0 ? mn++ : -1;
+    for (int i = 0; i < N1; ++i) nodeMap[i] = nodeMap[i] >= 0 ? mn++ : -1;
+    // Kept rows in runs between the dropped tets (nodes likewise).
+    auto keepRows = [](const auto& from, auto& to, const std::vector<std::int32_t>& gaps) {
+      Eigen::Index src = 0, dst = 0;
+      for (size_t g = 0; g <= gaps.size(); ++g) {
+        const Eigen::Index end = g < gaps.size() ? gaps[g] : from.rows();
+        if (end > src) to.middleRows(dst, end - src) = from.middleRows(src, end - src);
+        dst += end - src;
+        src = end + 1;
+      }
+    };
     TetMesh compact;
-    compact.X.resize(mn, 3);
     compact.T.resize(mt, 4);
     compact.material.resize(mt);
-    for (int i = 0; i < N1; ++i)
-      if (nodeMap[i] >= 0) compact.X.row(nodeMap[i]) = out.X.row(i);
-    for (int t = 0; t < M1; ++t)
-      if (tetMap[t] >= 0) {
-        for (int k = 0; k < 4; ++k) compact.T(tetMap[t], k) = nodeMap[out.T(t, k)];
-        compact.material(tetMap[t]) = out.material(t);
+    keepRows(out.T, compact.T, drop);
+    keepRows(out.material, compact.material, drop);
+    if (mn == N1) {
+      compact.X = std::move(out.X);
+    } else {
+      std::vector<std::int32_t> gone;
+      for (int i = 0; i < N1; ++i)
+        if (nodeMap[i] < 0) gone.push_back(i);
+      compact.X.resize(mn, 3);
+      keepRows(out.X, compact.X, gone);
+      for (int k = 0; k < 4; ++k) {
+        std::int32_t* col = compact.T.col(k).data();
+        for (int t = 0; t < mt; ++t) col[t] = nodeMap[col[t]];
       }
+    }
     out = std::move(compact);
     for (int i = 0; i < N0; ++i) change.node_old_to_new[i] = nodeMap[i];
     for (int t = 0; t < M0; ++t) {

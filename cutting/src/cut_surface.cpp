@@ -74,6 +74,21 @@ int CutSurface::build(int begin, int end) {
   return id;
 }
 
+namespace {
+// AlignedBox::squaredExteriorDistance without branches (the tree walks test many boxes):
+// the same terms summed in the same order (a zero term leaves the sum unchanged), so the
+// same value bit for bit, NaN coordinates included (they add nothing).
+inline double boxDistance2(const Eigen::AlignedBox3d& box, const Eigen::Vector3d& p) {
+  double dist2 = 0;
+  for (int k = 0; k < 3; ++k) {
+    const double below = box.min()[k] - p[k], above = p[k] - box.max()[k];
+    const double aux = (below > 0 ? below : 0.0) + (above > 0 ? above : 0.0);
+    dist2 += aux * aux;
+  }
+  return dist2;
+}
+}  // namespace
+
 Eigen::Vector3d closestPointOnTriangle(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                                        const Eigen::Vector3d& c) {
   // Voronoi-region walk (Ericson, Real-Time Collision Detection, 5.1.5).
@@ -110,7 +125,7 @@ double CutSurface::signedDistance(const Eigen::Vector3d& x, Eigen::Vector3d* clo
   stack[top++] = 0;
   while (top > 0) {
     const Node& node = nodes_[stack[--top]];
-    if (node.box.squaredExteriorDistance(x) >= best) continue;
+    if (boxDistance2(node.box, x) >= best) continue;
     if (node.left < 0) {
       for (int i = node.begin; i < node.end; ++i) {
         const Tri& t = tri_[order_[i]];
@@ -200,7 +215,41 @@ bool CutSurface::mayTouch(const Eigen::AlignedBox3d& box, double eps) const {
   Eigen::AlignedBox3d grown = box;
   grown.min().array() -= eps;
   grown.max().array() += eps;
-  return bounds_.intersects(grown);
+  // Down the tree: the box meets a leaf's box (a few triangles).
+  int stack[128];
+  int top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const Node& node = nodes_[stack[--top]];
+    if (!node.box.intersects(grown)) continue;
+    if (node.left < 0 || top + 2 > 128) return true;
+    stack[top++] = node.left;
+    stack[top++] = node.right;
+  }
+  return false;
+}
+
+bool CutSurface::within(const Eigen::Vector3d& x, double r) const {
+  if (is_plane_) return std::abs(normal_.dot(x - point_)) <= r;
+  // Boxes farther than r (with a margin for rounding) cannot hold a triangle within r.
+  const double limit = r * r * (1.0 + 1e-6) + std::numeric_limits<double>::min();
+  int stack[128];
+  int top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const Node& node = nodes_[stack[--top]];
+    if (boxDistance2(node.box, x) > limit) continue;
+    if (node.left < 0) {
+      for (int i = node.begin; i < node.end; ++i) {
+        const Tri& t = tri_[order_[i]];
+        if (std::sqrt((closestPointOnTriangle(x, t.a, t.b, t.c) - x).squaredNorm()) <= r) return true;
+      }
+    } else if (top + 2 <= 128) {
+      stack[top++] = node.left;
+      stack[top++] = node.right;
+    }
+  }
+  return false;
 }
 
 }  // namespace hysim::cutting

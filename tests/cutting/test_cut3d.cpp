@@ -347,6 +347,40 @@ TEST(Cut3D, CurvedSurfaceFullCutSeparatesPiece) {
   }
 }
 
+// CutSurface::within answers |signedDistance| <= r; mayTouch rules out boxes that meet the
+// surface's bounding box but no part of the surface (the inside of a curved strip).
+TEST(Cut3D, SurfaceWithinAndMayTouch) {
+  const CutSurface s = cylinderStrip(Vec3(0.5, 0, 1.05), 0.5, M_PI * 0.95, M_PI * 2.05, -0.1, 1.1, 40, 4);
+  int near = 0;
+  for (int i = 0; i < 2000; ++i) {
+    // Deterministic points over the strip's box and around it.
+    const Vec3 x(-0.2 + 1.4 * std::fmod(i * 0.6180339887, 1.0), -0.3 + 1.6 * std::fmod(i * 0.7548776662, 1.0),
+                 0.3 + 1.0 * std::fmod(i * 0.5698402910, 1.0));
+    for (double r : {1e-3, 0.05, 0.3}) {
+      const bool expect = std::abs(s.signedDistance(x)) <= r;
+      EXPECT_EQ(s.within(x, r), expect) << x.transpose() << " r " << r;
+      near += expect;
+    }
+    // A point's own box touches the surface iff the point is within eps of it (up to the
+    // leaf boxes being larger than their triangles: mayTouch may say yes, never wrongly no).
+    const Eigen::AlignedBox3d box(x, x);
+    if (std::abs(s.signedDistance(x)) <= 0.05) {
+      EXPECT_TRUE(s.mayTouch(box, 0.05));
+    }
+  }
+  EXPECT_GT(near, 100);
+  // The axis of the cylinder lies inside the strip's bounding box, 0.5 from every triangle.
+  const Eigen::AlignedBox3d axis(Vec3(0.45, 0.2, 1.0), Vec3(0.55, 0.8, 1.1));
+  EXPECT_TRUE(s.bounds().intersects(axis));
+  EXPECT_FALSE(s.mayTouch(axis, 1e-6));
+  EXPECT_FALSE(s.within(Vec3(0.5, 0.5, 1.05), 0.4));
+  EXPECT_TRUE(s.within(Vec3(0.5, 0.5, 1.05), 0.5 + 1e-9));
+  // Planes: within is |signed distance| <= r.
+  const CutSurface p = *CutSurface::plane(Vec3(0, 0, 1), Vec3(0, 0, 1));
+  EXPECT_TRUE(p.within(Vec3(3, 4, 1.2), 0.2 + 1e-12));
+  EXPECT_FALSE(p.within(Vec3(3, 4, 0.7), 0.2));
+}
+
 TEST(Cut3D, PartialCutStaysConnectedAndValid) {
   const TetMesh box = testing::boxTetMesh(6, 6, 6, 1.0 / 6);
   // A square patch in the middle of the box, slightly tilted: the cut ends inside.

@@ -52,8 +52,12 @@ class CutSurface {
 
   // The surface's bounding box (plane: empty box, i.e. unbounded).
   const Eigen::AlignedBox3d& bounds() const { return bounds_; }
-  // Does the box (grown by eps) possibly touch the surface?
+  // Does the box (grown by eps) possibly touch the surface? Surfaces: the grown box meets the
+  // box of a leaf of the tree (a few triangles); false means it surely does not.
   bool mayTouch(const Eigen::AlignedBox3d& box, double eps) const;
+  // |signedDistance(x)| <= r, without searching the surface farther than r from x (cheap for
+  // points far from the surface, unlike the nearest-point search).
+  bool within(const Eigen::Vector3d& x, double r) const;
 
  private:
   struct Tri {
