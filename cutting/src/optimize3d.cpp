@@ -372,7 +372,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     }
     CutSurface::Hit hit;
     return !region.surface->intersectSegment(x, y, region.eps, &hit) &&
-           std::abs(region.surface->signedDistance(y)) > region.eps;
+           !region.surface->within(y, region.eps);
   };
 
   // Peeling: a sliver (q* below peel_quality) with a face on the boundary is removed when
@@ -889,8 +889,10 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
         const int u = mesh.T(t, k);
         if (onCut[u] || tried[u]) continue;
         tried[u] = 1;
+        const double limit = options.collapse_fraction * region.edge_length;
+        if (!region.surface->within(pos(u), limit)) continue;  // far: no nearest-point search
         const double d = std::abs(region.surface->signedDistance(pos(u)));
-        if (d < options.collapse_fraction * region.edge_length) cands.emplace_back(d, u);
+        if (d < limit) cands.emplace_back(d, u);
       }
     std::sort(cands.begin(), cands.end());
     std::vector<std::int32_t> dying, changing, group, tets;
@@ -940,7 +942,9 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       if (newMin < oldMin && worstTet >= 0) {
         for (int k = 0; k < 4; ++k) {
           const int v = mesh.T(worstTet, k);
-          if (!onCut[v] && !inGroup(v) && std::abs(region.surface->signedDistance(pos(v))) < near) *partner = v;
+          if (!onCut[v] && !inGroup(v) && region.surface->within(pos(v), near) &&
+              std::abs(region.surface->signedDistance(pos(v))) < near)
+            *partner = v;
         }
       }
       if (dying.empty() || changing.empty() || newMin < oldMin ||
