@@ -16,7 +16,13 @@
 // faces; rim nodes (cut meets boundary) and crease nodes slide along their ridge (these moves
 // within a small volume budget of their own); 2-3 and 3-2 flips repair
 // slivers whose nodes cannot move; snaps and collapses may change a tiny star's volume by a
-// fraction of a regular tet of the local edge. Plane cuts are as before.
+// fraction of a regular tet of the local edge. Shaving passes also sweep over the rough
+// surfaces earlier passes left (thin flaps, slivers of four boundary nodes, fixed corners),
+// so on curved cuts: the repair region takes the poor tets within repair_rings of the cut;
+// interior edges with 4 to 6 tets around are removed (the ring triangulated as a fan) where
+// that helps; edges with neither end on the cut collapse too (one material, boundary into
+// boundary); the volume budgets bound the net change (collapses add and remove volume
+// locally), the sum of absolute changes volume_churn_factor x that. Plane cuts are as before.
 // Candidate moves (ascent along the gradient of the worst incident element's q*, a damped
 // spring step toward the local mean edge length, a push away from the face opposite the
 // node in its worst element; each tried at decreasing lengths) are kept only if no incident
