@@ -16,7 +16,13 @@
 // faces; rim nodes (cut meets boundary) and crease nodes slide along their ridge (these moves
 // within a small volume budget of their own); 2-3 and 3-2 flips repair
 // slivers whose nodes cannot move; snaps and collapses may change a tiny star's volume by a
-// fraction of a regular tet of the local edge. Plane cuts are as before.
+// fraction of a regular tet of the local edge. Shaving passes also sweep over the rough
+// surfaces earlier passes left (thin flaps, slivers of four boundary nodes, fixed corners),
+// so on curved cuts: the repair region takes the poor tets within repair_rings of the cut;
+// interior edges with 4 to 6 tets around are removed (the ring triangulated as a fan) where
+// that helps; edges with neither end on the cut collapse too (one material, boundary into
+// boundary); the volume budgets bound the net change (collapses add and remove volume
+// locally), the sum of absolute changes volume_churn_factor x that. Plane cuts are as before.
 // Candidate moves (ascent along the gradient of the worst incident element's q*, a damped
 // spring step toward the local mean edge length, a push away from the face opposite the
 // node in its worst element; each tried at decreasing lengths) are kept only if no incident
@@ -61,6 +67,18 @@ Eigen::Vector3d nearestOnTriangle(const Eigen::Vector3d& p, const Eigen::Vector3
   const double denom = 1.0 / (va + vb + vc);
   return a + ab * (vb * denom) + ac * (vc * denom);
 }
+// A volume budget: the net change stays within `limit`, the sum of the absolute changes
+// within churn_factor x limit.
+struct VolumeBudget {
+  double limit = 0, churn_factor = 1, net = 0, churn = 0;
+  bool fits(double dv) const {
+    return std::abs(net + dv) <= limit && churn + std::abs(dv) <= churn_factor * limit;
+  }
+  void spend(double dv) {
+    net += dv;
+    churn += std::abs(dv);
+  }
+};
 struct Constraint {
   Freedom kind = Freedom::Fixed;
   Vec3 normal = Vec3::Zero();  // Plane: moves are perpendicular to it
@@ -151,22 +169,25 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   buildStars();
   // Peeling and collapses change the volume; together they may change it by at most
   // volume_budget of the mesh's volume.
-  double budget = 0;
+  double meshVolume = 0;
   for (int t = 0; t < M; ++t) {
     // tetVolume, inline.
     const Vec3 x0 = mesh.X.row(mesh.T(t, 0)), x1 = mesh.X.row(mesh.T(t, 1)), x2 = mesh.X.row(mesh.T(t, 2)),
                x3 = mesh.X.row(mesh.T(t, 3));
-    budget += (x1 - x0).dot((x2 - x0).cross(x3 - x0)) / 6.0;
+    meshVolume += (x1 - x0).dot((x2 - x0).cross(x3 - x0)) / 6.0;
   }
-  const double meshVolume = budget;
-  budget *= options.volume_budget;
+  // Curved cuts: the budgets bound the net change of the mesh volume (collapses and moves
+  // add and remove volume; what they move about cancels) and, at volume_churn_factor x
+  // that, the sum of the absolute changes. Plane cuts: the sum of the absolute changes.
+  const double churnFactor = curved ? std::max(1.0, options.volume_churn_factor) : 1.0;
+  VolumeBudget budget{meshVolume * options.volume_budget, churnFactor};
   // A collapse or snap may change its star's volume by collapse_volume_fraction of the star,
   // or of a regular tet with the local edge length where the star is smaller (a node very
   // near the cut among tiny tets).
   const double edgeTet = region.edge_length * region.edge_length * region.edge_length / (6.0 * std::sqrt(2.0));
   // Moves on curved surfaces: each within move_volume_fraction of a regular tet of the local
   // edge, all together within move_volume_budget of the mesh's volume.
-  double moveBudget = meshVolume * options.move_volume_budget;
+  VolumeBudget moveBudget{meshVolume * options.move_volume_budget, churnFactor};
   const double refVolume = curved && options.collapse_volume_fraction_of_edge_tet ? edgeTet : 0.0;
   auto pos = [&](int i) -> Vec3 { return mesh.X.row(i).transpose(); };
   // q* of tet t, cached per tet with the node indices and positions it was computed from
@@ -478,6 +499,39 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   };
   std::vector<std::int32_t> around;
   std::vector<std::int32_t> lateSnapped;  // nodes snapNear moved onto the cut
+  // Curved cuts: the repair region also takes the poor tets (q* below flip_quality) within
+  // repair_rings edge steps of what the cut touched, left there by earlier cuts (a shaving
+  // pass sweeps over the surfaces of earlier ones): their nodes join the seeds.
+  std::vector<std::int32_t> seeds(region.seeds.begin(), region.seeds.end());
+  if (curved && options.repair_rings > 0 && options.flip_quality > 0) {
+    std::vector<std::uint8_t> reached(N, 0);
+    std::vector<std::int32_t> frontier, next;
+    for (int n : region.seeds)
+      if (n >= 0 && n < N && !reached[n]) {
+        reached[n] = 1;
+        frontier.push_back(n);
+      }
+    for (int r = 0; r < options.repair_rings && !frontier.empty(); ++r) {
+      next.clear();
+      for (int n : frontier)
+        for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s) {
+          if ((*dead)[*s]) continue;
+          const bool poor = tetQ(*s) < options.flip_quality;
+          for (int k = 0; k < 4; ++k) {
+            const int v = mesh.T(*s, k);
+            if (reached[v]) continue;
+            reached[v] = 1;
+            next.push_back(v);
+            if (poor) seeds.push_back(v);
+          }
+          if (poor)
+            for (int k = 0; k < 4; ++k) seeds.push_back(mesh.T(*s, k));
+        }
+      frontier.swap(next);
+    }
+    std::sort(seeds.begin() + static_cast<std::ptrdiff_t>(region.seeds.size()), seeds.end());
+    seeds.erase(std::unique(seeds.begin() + static_cast<std::ptrdiff_t>(region.seeds.size()), seeds.end()), seeds.end());
+  }
   // The live tets around the seeds, each once, in index order.
   // A bit per tet: set while collecting, read back word by word (index order), cleared.
   std::vector<std::uint64_t> tetBits(static_cast<size_t>(M) / 64 + 1, 0);
@@ -485,7 +539,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   auto regionTets = [&](std::vector<std::int32_t>& out) {
     out.clear();
     bitWords.clear();
-    for (int n : region.seeds)
+    for (int n : seeds)
       for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s) {
         const int t = (*s);
         if ((*dead)[t]) continue;
@@ -513,7 +567,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     for (bool again = true; again;) {
       again = false;
       for (int t : candidates) {
-        if ((*dead)[t] || boundaryFaceCount(t) == 0 || tetVolume(mesh, t) > budget) continue;
+        if ((*dead)[t] || boundaryFaceCount(t) == 0 || !budget.fits(-tetVolume(mesh, t))) continue;
         kill(t);
         bool ok = true;
         for (int k = 0; k < 4 && ok; ++k) {
@@ -525,7 +579,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
           continue;
         }
         again = true;
-        budget -= tetVolume(mesh, t);
+        budget.spend(-tetVolume(mesh, t));
         if (counts) {
           ++counts->peeled;
           counts->peeled_volume += tetVolume(mesh, t);
@@ -688,6 +742,104 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
               }
             }
           }
+        // Edge removal: the n (4 to 6) tets around an interior edge (a, b), all of t's
+        // material, become 2(n - 2): the ring of their other nodes is triangulated as a fan
+        // from one ring node and each triangle joined to a and to b. Valid when a and b lie on
+        // opposite sides of every triangle (all new tets positive); n > 4 takes free slots.
+        std::int32_t erRing[6], erTets[6];
+        int erN = 0, erApex = -1;
+        if (options.edge_removal) {
+          int avail = 0;
+          for (int fs : freeSlots) avail += (*dead)[fs] ? 1 : 0;
+          for (int i = 0; i < 4; ++i)
+            for (int j = i + 1; j < 4; ++j) {
+              const int a = mesh.T(t, i), b = mesh.T(t, j);
+              edgeTets.clear();
+              bool sameMat = true;
+              for (const std::int32_t *s = starB(a), *sEnd = starE(a); s < sEnd; ++s) {
+                if ((*dead)[*s]) continue;
+                int hits = 0;
+                for (int k = 0; k < 4; ++k) hits += mesh.T(*s, k) == a || mesh.T(*s, k) == b;
+                if (hits == 2) {
+                  edgeTets.push_back(*s);
+                  sameMat = sameMat && mesh.material(*s) == mesh.material(t);
+                }
+              }
+              const int n = static_cast<int>(edgeTets.size());
+              if (n < 4 || n > 6 || n - 4 > avail || !sameMat) continue;
+              // The ring: each tet's other two nodes, chained into one cycle.
+              std::int32_t pr[6][2], cyc[6], cycT[6];
+              bool used[6] = {false, false, false, false, false, false};
+              for (int e = 0; e < n; ++e) {
+                int m = 0;
+                for (int k = 0; k < 4; ++k)
+                  if (mesh.T(edgeTets[e], k) != a && mesh.T(edgeTets[e], k) != b && m < 2) pr[e][m++] = mesh.T(edgeTets[e], k);
+              }
+              cyc[0] = pr[0][0];
+              cyc[1] = pr[0][1];
+              cycT[0] = edgeTets[0];
+              used[0] = true;
+              bool closed = true;
+              for (int m = 2; m <= n && closed; ++m) {
+                const int from = cyc[m - 1];
+                int found = -1;
+                for (int e = 0; e < n && found < 0; ++e)
+                  if (!used[e] && (pr[e][0] == from || pr[e][1] == from)) found = e;
+                if (found < 0) {
+                  closed = false;
+                  break;
+                }
+                used[found] = true;
+                cycT[m - 1] = edgeTets[found];
+                const int to = pr[found][0] == from ? pr[found][1] : pr[found][0];
+                if (m < n) {
+                  for (int l = 0; l < m; ++l) closed = closed && cyc[l] != to;
+                  cyc[m] = to;
+                } else {
+                  closed = to == cyc[0];
+                }
+              }
+              if (!closed) continue;
+              double old = 1.0;
+              for (int u : edgeTets) old = std::min(old, tetQ(u));
+              for (int apex = 0; apex < n; ++apex) {
+                double qn = 1.0;
+                int sign = 0;
+                for (int m = 1; m + 1 < n && qn > best; ++m) {
+                  const int p0 = cyc[apex], p1 = cyc[(apex + m) % n], p2 = cyc[(apex + m + 1) % n];
+                  const double va = vol6(p0, p1, p2, a), vb = vol6(p0, p1, p2, b);
+                  const int sg = va > 0 ? 1 : -1;
+                  if (!(va * vb < 0) || (sign != 0 && sg != sign)) {
+                    qn = -1;
+                    break;
+                  }
+                  sign = sg;
+                  qn = std::min(qn, sg > 0 ? std::min(q4(p0, p1, p2, a), q4(p0, p2, p1, b))
+                                           : std::min(q4(p0, p2, p1, a), q4(p0, p1, p2, b)));
+                }
+                if (!(qn > best && qn > old)) continue;
+                // The fan's diagonals must not be edges already (where the mesh folds).
+                bool exists = false;
+                for (int m = 2; m + 1 < n && !exists; ++m) {
+                  const int d0 = cyc[apex], d1 = cyc[(apex + m) % n];
+                  for (const std::int32_t *s = starB(d0), *sEnd = starE(d0); s < sEnd && !exists; ++s)
+                    if (!(*dead)[*s])
+                      for (int k = 0; k < 4; ++k) exists = exists || mesh.T(*s, k) == d1;
+                }
+                if (exists) continue;
+                best = qn;
+                bestKind = 2;
+                bestI = a;
+                bestJ = b;
+                erN = n;
+                erApex = apex;
+                for (int e = 0; e < n; ++e) {
+                  erRing[e] = cyc[e];
+                  erTets[e] = cycT[e];
+                }
+              }
+            }
+        }
         if (bestKind == 0) {
           int v[4];
           for (int k = 0; k < 4; ++k) v[k] = mesh.T(t, k);
@@ -710,6 +862,32 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
           setTet(ringTets[1], ring[0], ring[2], ring[1], bestJ);
           kill(ringTets[2]);
           freeSlots.push_back(ringTets[2]);
+          ++done;
+          if (counts) ++counts->flips;
+        } else if (bestKind == 2) {
+          const int a = bestI, b = bestJ, n = erN;
+          std::int32_t slots[8];
+          for (int e = 0; e < n; ++e) slots[e] = erTets[e];
+          for (int e = n; e < 2 * (n - 2); ++e) {
+            while (!freeSlots.empty() && !(*dead)[freeSlots.back()]) freeSlots.pop_back();
+            slots[e] = freeSlots.back();  // (there are: counted when the removal was chosen)
+            freeSlots.pop_back();
+            (*dead)[slots[e]] = 0;
+            mesh.material(slots[e]) = mesh.material(t);
+          }
+          int next = 0;
+          for (int m = 1; m + 1 < n; ++m) {
+            const int p0 = erRing[erApex], p1 = erRing[(erApex + m) % n], p2 = erRing[(erApex + m + 1) % n];
+            if (vol6(p0, p1, p2, a) > 0) {
+              setTet(slots[next++], p0, p1, p2, a);
+              setTet(slots[next++], p0, p2, p1, b);
+            } else {
+              setTet(slots[next++], p0, p2, p1, a);
+              setTet(slots[next++], p0, p1, p2, b);
+            }
+          }
+          touch(a);
+          touch(b);
           ++done;
           if (counts) ++counts->flips;
         }
@@ -736,6 +914,14 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       double len;
       std::int32_t u, v;
       bool shortEdge;
+      bool offCut;  // v is not on the cut (curved cuts, collapse_off_cut)
+    };
+    const bool offCutToo = curved && options.collapse_off_cut;
+    // Does node n have a boundary face?
+    auto onBoundary = [&](int n) {
+      liveStar(n, vstar, nullptr);
+      discAround(n, vstar);
+      return !link.empty();
     };
     for (int batch = 0; batch < 3; ++batch) {
       std::vector<Cand> cands;
@@ -756,8 +942,12 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
             const double len = lens[e];
             const bool shortEdge = len < options.collapse_fraction * std::max(mean, region.edge_length);
             if (!shortEdge && q >= options.quality_target) continue;
-            if (onCut[y]) cands.push_back({len, x, y, shortEdge});
-            if (onCut[x]) cands.push_back({len, y, x, shortEdge});
+            if (onCut[y]) cands.push_back({len, x, y, shortEdge, false});
+            if (onCut[x]) cands.push_back({len, y, x, shortEdge, false});
+            if (offCutToo && !onCut[x] && !onCut[y]) {
+              cands.push_back({len, x, y, shortEdge, true});
+              cands.push_back({len, y, x, shortEdge, true});
+            }
           }
       }
       std::sort(cands.begin(), cands.end(), [](const Cand& p, const Cand& q) {
@@ -777,6 +967,14 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
           (hasV ? dying : changing).push_back(t);
         }
         if (dying.empty()) continue;  // not an edge any more
+        if (c.offCut) {
+          // Off the cut: within one material, and a boundary node only into a boundary node
+          // (an interior node's star keeps its volume).
+          bool oneMaterial = true;
+          for (int t : dying) oneMaterial = oneMaterial && mesh.material(t) == mesh.material(dying[0]);
+          for (int t : changing) oneMaterial = oneMaterial && mesh.material(t) == mesh.material(dying[0]);
+          if (!oneMaterial || (onBoundary(u) && !onBoundary(v))) continue;
+        }
         // Checks in order of cost (all must pass): no changed tet inverts or goes flat, the
         // volume changes within the limits, the worst q* rises (short edges: does not fall).
         bool ok = true;
@@ -800,7 +998,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
           after += (p[1] - p[0]).dot((p[2] - p[0]).cross(p[3] - p[0])) / 6.0;
         }
         const double change = std::abs(after - before);
-        if (change > options.collapse_volume_fraction * std::max(before, refVolume) || change > budget) continue;
+        if (change > options.collapse_volume_fraction * std::max(before, refVolume) || !budget.fits(after - before)) continue;
         double oldMin = 1.0;
         for (int t : dying) oldMin = std::min(oldMin, tetQ(t));
         for (int t : changing) oldMin = std::min(oldMin, tetQ(t));
@@ -861,7 +1059,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
           continue;
         }
         locked[u] = locked[v] = 1;
-        budget -= change;
+        budget.spend(after - before);
         ++done;
         if (counts) {
           ++counts->collapsed;
@@ -948,7 +1146,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
         }
       }
       if (dying.empty() || changing.empty() || newMin < oldMin ||
-          change > options.collapse_volume_fraction * std::max(before, refVolume) || change > budget) {
+          change > options.collapse_volume_fraction * std::max(before, refVolume) || !budget.fits(after - before)) {
         return false;
       }
       groupFrom.clear();
@@ -979,7 +1177,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
         lateSnapped.push_back(g);
         if (counts) ++counts->late_snaps;
       }
-      budget -= change;
+      budget.spend(after - before);
       return true;
     };
     for (const auto& [dist, u] : cands) {
@@ -1035,7 +1233,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   std::vector<std::int8_t> ring(N, -1);
   {
     std::vector<std::int32_t> frontier, next;
-    for (int n : region.seeds)
+    for (int n : seeds)
       if (n >= 0 && n < N && ring[n] < 0) {
         ring[n] = 0;
         frontier.push_back(n);
@@ -1069,7 +1267,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       }
     }
   };
-  for (int n : region.seeds)
+  for (int n : seeds)
     if (n >= 0 && n < N) addBadAround(n, 0);
   std::vector<std::uint8_t> didMove(N, 0);
   std::vector<std::int32_t> movedNow;
@@ -1185,19 +1383,19 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
               for (int k = 0; k < 4; ++k) p[k] = mesh.T(*s, k) == n ? y : pos(mesh.T(*s, k));
               dv += (p[1] - p[0]).dot((p[2] - p[0]).cross(p[3] - p[0])) / 6.0 - tetVolume(mesh, *s);
             }
-            if (std::abs(dv) > moveBudget || std::abs(dv) > options.move_volume_fraction * edgeTet) continue;
+            if (!moveBudget.fits(dv) || std::abs(dv) > options.move_volume_fraction * edgeTet) continue;
           }
           double q = 0;
           if (starAbove(n, y, wt, best, &q)) {
             best = q;
             bestX = y;
-            bestDv = std::abs(dv);
+            bestDv = dv;
             break;
           }
         }
       }
       if (best > before) {
-        moveBudget -= bestDv;
+        moveBudget.spend(bestDv);
         largest = std::max(largest, (bestX - x).norm());
         mesh.X.row(n) = bestX.transpose();
         didMove[n] = 1;

@@ -187,6 +187,60 @@ TEST(Shaving, SamePassTwiceGivesTheSameState) {
   EXPECT_EQ((*a)->stateHash(), (*b)->stateHash());
 }
 
+// Three overlapping passes over the slab (the second and third deeper, 2 mm to either side
+// of the first, so their sweeps cross the first pass's cut surface, as shaving does): after
+// every pass the mesh is valid (no inverted or flat tet, manifold, no duplicate faces).
+TEST(Shaving, OverlappingPassesKeepTheMeshValid) {
+  const fs::path dir = fs::path(HYSIM_TEST_OUTPUT_DIR) / "shaving";
+  fs::create_directories(dir);
+  cutting::TetMesh slab = testing::boxTetMesh(15, 10, 5, 2.0);
+  for (int i = 0; i < slab.numNodes(); ++i) slab.X.row(i) -= Eigen::RowVector3d(15, 10, 10);
+  ASSERT_TRUE(cutting::writeMesh((dir / "slab.msh").string(), slab).ok());
+  std::ofstream(dir / "slab_passes.yaml")
+      << "name: slab\n"
+         "mesh: slab.msh\n"
+         "materials:\n"
+         "  - {name: myoma, label: 1, young_modulus_kpa: 150, density_g_cm3: 1.1}\n"
+         "anchors:\n"
+         "  - box: {min: [-20, -20, -11], max: [20, 20, -9.5]}\n"
+         "simulation: {dt_ms: 1.0, steps: 5200, drag_per_s: 30, gravity_mm_s2: [0, 0, 0]}\n"
+         "tool_path:\n"
+         "  - {t_s: 0.0, tip: [8, 0, 4.5], axis: [1, 0, 0], up: [0, 0, 1]}\n"
+         "  - {t_s: 0.05, tip: [8, 0, 4.5], axis: [1, 0, 0], up: [0, 0, 1], pedal: true}\n"
+         "  - {t_s: 1.05, tip: [-32, 0, 4.5], axis: [1, 0, 0], up: [0, 0, 1], pedal: true}\n"
+         "  - {t_s: 1.10, tip: [-32, 0, 4.5], axis: [1, 0, 0], up: [0, 0, 1]}\n"
+         "  - {t_s: 1.30, tip: [-32, 0, 14], axis: [1, 0, 0], up: [0, 0, 1]}\n"
+         "  - {t_s: 1.80, tip: [8, 2, 14], axis: [1, 0, 0], up: [0, 0, 1]}\n"
+         "  - {t_s: 2.00, tip: [8, 2, 4.0], axis: [1, 0, 0], up: [0, 0, 1]}\n"
+         "  - {t_s: 2.05, tip: [8, 2, 4.0], axis: [1, 0, 0], up: [0, 0, 1], pedal: true}\n"
+         "  - {t_s: 3.05, tip: [-32, 2, 4.0], axis: [1, 0, 0], up: [0, 0, 1], pedal: true}\n"
+         "  - {t_s: 3.10, tip: [-32, 2, 4.0], axis: [1, 0, 0], up: [0, 0, 1]}\n"
+         "  - {t_s: 3.30, tip: [-32, 2, 14], axis: [1, 0, 0], up: [0, 0, 1]}\n"
+         "  - {t_s: 3.80, tip: [8, -2, 14], axis: [1, 0, 0], up: [0, 0, 1]}\n"
+         "  - {t_s: 4.00, tip: [8, -2, 3.7], axis: [1, 0, 0], up: [0, 0, 1]}\n"
+         "  - {t_s: 4.05, tip: [8, -2, 3.7], axis: [1, 0, 0], up: [0, 0, 1], pedal: true}\n"
+         "  - {t_s: 5.05, tip: [-32, -2, 3.7], axis: [1, 0, 0], up: [0, 0, 1], pedal: true}\n"
+         "  - {t_s: 5.10, tip: [-32, -2, 3.7], axis: [1, 0, 0], up: [0, 0, 1]}\n";
+  auto scene = loadScene((dir / "slab_passes.yaml").string());
+  ASSERT_TRUE(scene.ok()) << scene.error();
+  auto sim = Simulation::create(*scene);
+  ASSERT_TRUE(sim.ok()) << sim.error();
+  size_t checked = 0;
+  for (int i = 0; i < 5200; ++i) {
+    (*sim)->step();
+    if ((*sim)->passes().size() == checked) continue;
+    checked = (*sim)->passes().size();
+    const PassRecord& pass = (*sim)->passes().back();
+    EXPECT_FALSE(pass.cut_failed) << pass.message;
+    const Status v = cutting::validate((*sim)->mesh());
+    EXPECT_TRUE(v.ok()) << "after pass " << checked << ": " << v.error();
+  }
+  EXPECT_EQ(checked, 3u);
+  for (const PassRecord& pass : (*sim)->passes()) EXPECT_GT(pass.crossed_edges, 0);
+  EXPECT_LT((*sim)->mesh().numTets(), 6 * 15 * 10 * 5 * 12 / 10);
+  EXPECT_EQ((*sim)->state().warnings, 0);
+}
+
 // setCutDumpDir: the pass writes its cut's input; cutting the written mesh with the written
 // surface (default options, as the pass) repeats the pass's cut.
 TEST(Shaving, DumpedCutInputRepeatsThePassesCut) {

@@ -82,12 +82,28 @@ struct Optimize3DOptions {
   // flips of interior faces and edges, within one material) where that raises the worst q*
   // of the tets involved. 0 disables.
   double flip_quality = 0.1;
+  // Curved cuts: poor tets (q* below flip_quality) within this many edge steps of what the
+  // cut touched join the repair (earlier cuts' leftovers the sweep passes near). 0: only
+  // the tets around the cut.
+  int repair_rings = 2;
+  // Curved cuts: interior edges with 4 to 6 tets around, all of one material, are removed
+  // (the ring of their other nodes triangulated as a fan, each triangle joined to both ends)
+  // where that raises the worst q* of the tets involved. Needs free tet slots beyond 4.
+  bool edge_removal = true;
   double peel_quality = 0.03;
   double collapse_fraction = 0.25;  // edges with an end on the cut shorter than this x their tet's mean edge
+  // Curved cuts: edges of poor tets near the cut (or short ones) with neither end on the cut
+  // are collapsed too (either way; within one material; a boundary node only into a
+  // boundary node), with the checks of the collapses on the cut.
+  bool collapse_off_cut = true;
   double collapse_volume_fraction = 0.1;  // a collapse changes its star's volume by at most this
   // ... of the star or, where the star is smaller, of a regular tet with the cut's local edge.
   bool collapse_volume_fraction_of_edge_tet = true;
   double volume_budget = 5e-4;  // peeling + collapses change the mesh volume by at most this (relative)
+  // Curved cuts: volume_budget and move_volume_budget bound the net change of the volume
+  // (collapses and moves add and remove volume locally); the sum of the absolute changes
+  // may reach this x the budget. Plane cuts: the sum of the absolute changes (as 1).
+  double volume_churn_factor = 4.0;
 };
 
 struct Cut3DOptions {
