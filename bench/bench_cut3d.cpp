@@ -89,6 +89,12 @@ const Prepared& mesh(int which) {
 const Vec3 kNormals[4] = {{0.05, 0.1, 1.0}, {1.0, 0.12, 0.07}, {0.1, 1.0, 0.2}, {0.6, -0.5, 0.8}};
 const Vec3 kOffsets[4] = {{0.3, -0.2, 1.1}, {0.7, 0.4, -0.6}, {-0.5, 1.3, 0.2}, {0.2, 0.1, -2.4}};
 
+// Plane `which` of the four, through the mesh's bounding-box centre.
+hysim::cutting::CutSurface planeThrough(const TetMesh& m, int which) {
+  const Vec3 lo = m.X.colwise().minCoeff().transpose(), hi = m.X.colwise().maxCoeff().transpose();
+  return *hysim::cutting::CutSurface::plane(0.5 * (lo + hi) + kOffsets[which], kNormals[which].normalized());
+}
+
 // The simulator's update after a pass: anchored after the cut are the surviving nodes that
 // were anchored (new nodes are free); `model` is a copy of p.model, updated in place.
 hysim::Status incrementalUpdate(const Prepared& p, const hysim::cutting::Cut3DResult& r, hysim::sim::Model& model,
@@ -110,8 +116,7 @@ void BM_Cut3DUpdate(benchmark::State& state) {
     state.SkipWithError("cannot read or model the mesh (assets/uterus_myoma.msh, tests/data/cutting/uterus_20k.msh)");
     return;
   }
-  const Vec3 lo = p.mesh.X.colwise().minCoeff().transpose(), hi = p.mesh.X.colwise().maxCoeff().transpose();
-  const auto surface = *hysim::cutting::CutSurface::plane(0.5 * (lo + hi) + kOffsets[plane], kNormals[plane].normalized());
+  const auto surface = planeThrough(p.mesh, plane);
   const bool incremental = state.range(3) != 0;
   double cutMs = 0, optMs = 0, updMs = 0;
   int elements = 0, nodes = 0;
@@ -186,8 +191,7 @@ void BM_Cut3D(benchmark::State& state) {
     state.SkipWithError("cannot read the mesh");
     return;
   }
-  const Vec3 lo = p.mesh.X.colwise().minCoeff().transpose(), hi = p.mesh.X.colwise().maxCoeff().transpose();
-  const auto surface = *hysim::cutting::CutSurface::plane(0.5 * (lo + hi) + kOffsets[plane], kNormals[plane].normalized());
+  const auto surface = planeThrough(p.mesh, plane);
   for (auto _ : state) {
     auto r = hysim::cutting::cut3d(p.mesh, surface, o);
     benchmark::DoNotOptimize(r);
