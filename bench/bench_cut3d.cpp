@@ -10,16 +10,22 @@
 // counters split it: cut_ms (cut3d, incl. optimisation), optimize_ms, update_ms. Medians over
 // the repetitions (the `_median` rows). Run from anywhere:
 //   ./build/bench/bench_cut3d --benchmark_filter='BM_Cut3DUpdate/./././1'   (incremental)
+// BM_Cut3DReplay: recorded shaving passes (HYSIM_REPLAY_DIR, see below).
 // BM_Cut3DSurface: the same meshes cut by a curved swept strip (the shaving passes' surfaces):
 //   ./build/bench/bench_cut3d --benchmark_filter='BM_Cut3DSurface'
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <string>
+#include <vector>
 
 #include "hysim/cutting/cut3d.hpp"
 #include "hysim/cutting/mesh_io.hpp"
+#include "hysim/cutting/mesh_stats.hpp"
 #include "hysim/sim/model.hpp"
 #include "hysim/sim/tissue_update3d.hpp"
 
@@ -291,6 +297,78 @@ BENCHMARK(BM_Cut3DSurface)
     ->MinTime(0.2)
     ->Repetitions(5)
     ->ReportAggregatesOnly(true);
+
+// Recorded shaving passes: the inputs of the simulator's cuts dumped as
+// $HYSIM_REPLAY_DIR/pass_NNN_mesh.msh and pass_NNN_surface.msh (NNN = 001, 002, ... up to the
+// first missing one). Each iteration cuts every pass (hybrid, default options; no tissue
+// update). Counters: the median and the largest per-pass cut_ms (cut3d incl. optimisation)
+// and optimize_ms over all passes and iterations, passes, and the sum over the passes of the
+// last iteration's q*_min (a quick check that quality is unchanged). Skipped when
+// HYSIM_REPLAY_DIR is unset or holds no pass.
+//   HYSIM_REPLAY_DIR=/path/to/dump ./build/bench/bench_cut3d --benchmark_filter=BM_Cut3DReplay
+struct ReplayPass {
+  TetMesh mesh;
+  hysim::cutting::CutSurface surface;
+};
+const std::vector<ReplayPass>& replayPasses() {
+  static const std::vector<ReplayPass> passes = [] {
+    std::vector<ReplayPass> out;
+    const char* dir = std::getenv("HYSIM_REPLAY_DIR");
+    if (dir == nullptr || *dir == 0) return out;
+    for (int i = 1;; ++i) {
+      char name[32];
+      std::snprintf(name, sizeof(name), "/pass_%03d_", i);
+      auto m = hysim::cutting::readTetMesh(std::string(dir) + name + "mesh.msh");
+      auto tri = hysim::cutting::readTriMesh(std::string(dir) + name + "surface.msh");
+      if (!m.ok() || !tri.ok()) break;
+      auto s = hysim::cutting::CutSurface::triangles(tri->X, tri->F);
+      if (!s.ok()) break;
+      out.push_back({std::move(*m), std::move(*s)});
+    }
+    return out;
+  }();
+  return passes;
+}
+
+void BM_Cut3DReplay(benchmark::State& state) {
+  const auto& passes = replayPasses();
+  if (passes.empty()) {
+    state.SkipWithError("HYSIM_REPLAY_DIR unset or without pass_001_mesh.msh / pass_001_surface.msh");
+    return;
+  }
+  const hysim::cutting::Cut3DOptions o;
+  std::vector<double> cutMs, optMs;
+  double qSum = 0;
+  for (auto _ : state) {
+    qSum = 0;
+    for (const auto& p : passes) {
+      const auto t0 = std::chrono::steady_clock::now();
+      auto r = hysim::cutting::cut3d(p.mesh, p.surface, o);
+      const auto t1 = std::chrono::steady_clock::now();
+      if (!r.ok()) {
+        state.SkipWithError(r.error().c_str());
+        return;
+      }
+      cutMs.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
+      optMs.push_back(r->report.optimize_ms);
+      state.PauseTiming();
+      qSum += hysim::cutting::computeStats(r->mesh).q_min;
+      state.ResumeTiming();
+      benchmark::DoNotOptimize(r);
+    }
+  }
+  auto medianOf = [](std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    return v.empty() ? 0.0 : v[v.size() / 2];
+  };
+  state.counters["cut_ms"] = medianOf(cutMs);
+  state.counters["optimize_ms"] = medianOf(optMs);
+  state.counters["cut_ms_max"] = cutMs.empty() ? 0.0 : *std::max_element(cutMs.begin(), cutMs.end());
+  state.counters["optimize_ms_max"] = optMs.empty() ? 0.0 : *std::max_element(optMs.begin(), optMs.end());
+  state.counters["passes"] = static_cast<double>(passes.size());
+  state.counters["q_min_sum"] = qSum;
+}
+BENCHMARK(BM_Cut3DReplay)->Unit(benchmark::kMillisecond)->Iterations(3)->Repetitions(1);
 
 }  // namespace
 
