@@ -125,21 +125,26 @@ double CutSurface::signedDistance(const Eigen::Vector3d& x, Eigen::Vector3d* clo
   stack[top++] = 0;
   while (top > 0) {
     const Node& node = nodes_[stack[--top]];
-    if (boxDistance2(node.box, x) >= best) continue;
+    if (boxDistance2(node.box, x) > best) continue;  // (equal: a tie with a lower index may be there)
     if (node.left < 0) {
       for (int i = node.begin; i < node.end; ++i) {
         const Tri& t = tri_[order_[i]];
         const Eigen::Vector3d q = closestPointOnTriangle(x, t.a, t.b, t.c);
         const double d2 = (q - x).squaredNorm();
-        if (d2 < best) {
+        // (Ties: the lower triangle index, whatever the order of the walk.)
+        if (d2 < best || (d2 == best && order_[i] < bestTri)) {
           best = d2;
           bestTri = order_[i];
           bestPoint = q;
         }
       }
     } else if (top + 2 <= 128) {
-      stack[top++] = node.left;
-      stack[top++] = node.right;
+      // The nearer child first (pushed last): a close triangle found early prunes the rest.
+      const double dl = boxDistance2(nodes_[node.left].box, x), dr = boxDistance2(nodes_[node.right].box, x);
+      const bool leftFirst = dl <= dr;
+      const double dFar = leftFirst ? dr : dl, dNear = leftFirst ? dl : dr;
+      if (dFar <= best) stack[top++] = leftFirst ? node.right : node.left;
+      if (dNear <= best) stack[top++] = leftFirst ? node.left : node.right;
     }
   }
   if (closest) *closest = bestPoint;
@@ -245,8 +250,11 @@ bool CutSurface::within(const Eigen::Vector3d& x, double r) const {
         if (std::sqrt((closestPointOnTriangle(x, t.a, t.b, t.c) - x).squaredNorm()) <= r) return true;
       }
     } else if (top + 2 <= 128) {
-      stack[top++] = node.left;
-      stack[top++] = node.right;
+      // The nearer child first (pushed last): a hit there ends the walk sooner.
+      const double dl = boxDistance2(nodes_[node.left].box, x), dr = boxDistance2(nodes_[node.right].box, x);
+      const bool leftFirst = dl <= dr;
+      if ((leftFirst ? dr : dl) <= limit) stack[top++] = leftFirst ? node.right : node.left;
+      if ((leftFirst ? dl : dr) <= limit) stack[top++] = leftFirst ? node.left : node.right;
     }
   }
   return false;
