@@ -947,12 +947,12 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
         }
         if (dying.empty()) continue;  // not an edge any more
         if (c.offCut) {
-          // Off the cut: within one material, and a boundary node only into a boundary node
-          // (an interior node's star keeps its volume).
+          // Off the cut: within one material (the boundary check, which costs more, comes
+          // after the geometric ones; all checks must pass and have no side effects).
           bool oneMaterial = true;
           for (int t : dying) oneMaterial = oneMaterial && mesh.material(t) == mesh.material(dying[0]);
           for (int t : changing) oneMaterial = oneMaterial && mesh.material(t) == mesh.material(dying[0]);
-          if (!oneMaterial || (onBoundary(u) && !onBoundary(v))) continue;
+          if (!oneMaterial) continue;
         }
         // Checks in order of cost (all must pass): no changed tet inverts or goes flat, the
         // volume changes within the limits, the worst q* rises (short edges: does not fall).
@@ -1009,6 +1009,9 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
             if (k == kb) ok = false;
         }
         if (!ok) continue;
+        // Off the cut: a boundary node only into a boundary node (an interior node's star
+        // keeps its volume).
+        if (c.offCut && onBoundary(u) && !onBoundary(v)) continue;
         // Apply, check manifoldness around v and the other nodes of the removed tets, or undo.
         for (int t : dying) kill(t);
         touch(u);
@@ -1352,6 +1355,9 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
             }
             y = best;
           }
+          // The checks below must all pass and have no side effects: the cheapest first (the
+          // worst tet, which starAbove tries first anyway), the surface queries after it.
+          if (!(tetQAt(wt, n, y) > best)) continue;
           if (!sideKept(n, x, y)) continue;
           // Moves on a curved surface change the volume a little (the faces are chords): within the budget.
           double dv = 0;
