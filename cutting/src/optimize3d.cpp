@@ -932,6 +932,21 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       std::sort(cands.begin(), cands.end(), [](const Cand& p, const Cand& q) {
         return p.len != q.len ? p.len < q.len : p.u != q.u ? p.u < q.u : p.v < q.v;
       });
+      // An edge comes once per poor tet around it: one candidate per (u, v), short if any
+      // of its copies is (a short edge's test accepts what the other accepts, and copies
+      // would be tried one after the other on the same mesh).
+      {
+        size_t kept = 0;
+        for (size_t i = 0; i < cands.size(); ++i) {
+          if (kept > 0 && cands[kept - 1].len == cands[i].len && cands[kept - 1].u == cands[i].u &&
+              cands[kept - 1].v == cands[i].v) {
+            cands[kept - 1].shortEdge = cands[kept - 1].shortEdge || cands[i].shortEdge;
+            continue;
+          }
+          cands[kept++] = cands[i];
+        }
+        cands.resize(kept);
+      }
       int done = 0;
       for (const Cand& c : cands) {
         const int u = c.u, v = c.v;
@@ -1258,12 +1273,13 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     double largest = 0, scale = 0;
     movedNow.clear();
     for (int n : work) {
-      const Constraint c = constraintOf(n);
-      if (c.kind == Freedom::Fixed) continue;
-      const Vec3 x = pos(n);
+      // (The cached quality test before the constraint, which looks at the whole star.)
       int wt = -1;
       const double before = starWorst(n, &wt);
       if (before < 0 || before >= options.quality_target || wt < 0) continue;
+      const Constraint c = constraintOf(n);
+      if (c.kind == Freedom::Fixed) continue;
+      const Vec3 x = pos(n);
       auto project = [&](Vec3 d) {
         if (c.kind != Freedom::Free && c.kind != Freedom::Ridge) d -= d.dot(c.normal) * c.normal;
         return d;
