@@ -149,23 +149,31 @@ bool updateFaces(const cutting::TetMesh& before, const std::vector<int>& next_be
 }
 
 Pieces tetPieces(const cutting::TetMesh& mesh, const std::vector<int>& next, const std::vector<std::uint8_t>& anchored) {
+  // Flood fill over shared faces, pieces numbered in the order of their lowest tet (as a
+  // union-find numbering its roots in tet order would): O(#T), no long parent chains.
   const int M = mesh.numTets();
-  std::vector<int> parent(static_cast<size_t>(M));
-  for (int t = 0; t < M; ++t) parent[t] = t;
-  auto find = [&](int x) {
-    while (parent[x] != x) x = parent[x] = parent[parent[x]];
-    return x;
-  };
-  // Each cycle ascends through its slots and wraps once: its ascending links join it all.
-  for (size_t s = 0; s < next.size(); ++s)
-    if (next[s] > static_cast<int>(s)) parent[find(static_cast<int>(s / 4))] = find(next[s] / 4);
   Pieces c;
   c.label.assign(static_cast<size_t>(M), -1);
-  std::vector<int> id(static_cast<size_t>(M), -1);
+  std::vector<int> stack;
+  stack.reserve(64);
+  const size_t slots = std::min(next.size(), 4 * static_cast<size_t>(M));
   for (int t = 0; t < M; ++t) {
-    const int r = find(t);
-    if (id[r] < 0) id[r] = c.count++;
-    c.label[t] = id[r];
+    if (c.label[t] >= 0) continue;
+    const int id = c.count++;
+    c.label[t] = id;
+    stack.push_back(t);
+    while (!stack.empty()) {
+      const int u = stack.back();
+      stack.pop_back();
+      for (int f = 0; f < 4; ++f) {
+        const size_t s = 4 * static_cast<size_t>(u) + f;
+        if (s >= slots) break;
+        const int p = next[s];
+        if (p < 0 || p / 4 >= M || c.label[p / 4] >= 0) continue;
+        c.label[p / 4] = id;
+        stack.push_back(p / 4);
+      }
+    }
   }
   c.free.assign(static_cast<size_t>(c.count), 1);
   for (int t = 0; t < M; ++t)

@@ -526,9 +526,7 @@ void Simulation::finishPass() {
     const Eigen::Vector3d w = m.inverse() * (p - a);
     return Eigen::Vector4d(1.0 - w.sum(), w[0], w[1], w[2]);
   };
-  std::vector<int> node_tet(mesh_.numNodes(), -1);  // a tet around each surface node
-  for (int t = 0; t < mesh_.numTets(); ++t)
-    for (int k = 0; k < 4; ++k) node_tet[mesh_.T(t, k)] = t;
+  std::vector<int> node_tet;  // a tet around each node (the last that has it), at the first point outside
   const int kept = static_cast<int>(kept_rows.size());
   NearestPoint nearest_surface;  // built at the first point outside the tissue
   bool nearest_built = false;
@@ -540,6 +538,9 @@ void Simulation::finishPass() {
       if (t < 0) {
         if (!nearest_built) {
           nearest_surface.build(state_.x, surface_nodes_);
+          node_tet.assign(static_cast<size_t>(mesh_.numNodes()), -1);
+          for (int u = 0; u < mesh_.numTets(); ++u)
+            for (int k = 0; k < 4; ++k) node_tet[mesh_.T(u, k)] = u;
           nearest_built = true;
         }
         const int nearest = nearest_surface.nearest(p);

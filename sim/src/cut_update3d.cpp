@@ -117,6 +117,8 @@ double topEigenvalue(const Model& m, const cutting::Positions& X, const std::vec
   Eigen::VectorXd z(n3);
   double theta = 0.0;
   Eigen::VectorXd ritz;
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(max_steps);
+  Eigen::VectorXd tri_diag(max_steps), tri_sub(max_steps);
   for (int j = 0; j < max_steps; ++j) {
     Q.col(j) = q;
     apply(q, z);
@@ -127,14 +129,25 @@ double topEigenvalue(const Model& m, const cutting::Positions& X, const std::vec
     if (reorthogonalise) z -= Q.leftCols(j + 1) * (Q.leftCols(j + 1).transpose() * z);
     const double b = z.norm();
     const int size = j + 1;
-    Eigen::MatrixXd T = Eigen::MatrixXd::Zero(size, size);
-    for (int i = 0; i < size; ++i) {
-      T(i, i) = alpha[i];
-      if (i + 1 < size) T(i, i + 1) = T(i + 1, i) = beta[i];
+    // T is tridiagonal already: solved as such (Eigen's dense compute() would reduce it by
+    // Householder reflections that are all the identity here, O(size^3) per step). Scaled as
+    // compute() scales (by its largest entry), so the values are the same to the last bit.
+    double scale = 0.0;
+    for (int i = 0; i < size; ++i) scale = std::max(scale, std::abs(alpha[i]));
+    for (int i = 0; i + 1 < size; ++i) scale = std::max(scale, std::abs(beta[i]));
+    if (scale == 0.0) scale = 1.0;
+    tri_diag.resize(size);
+    tri_sub.resize(size - 1);
+    for (int i = 0; i < size; ++i) tri_diag[i] = alpha[i] / scale;
+    for (int i = 0; i + 1 < size; ++i) tri_sub[i] = beta[i] / scale;
+    if (size == 1) {
+      theta = alpha[0];
+      ritz = Eigen::VectorXd::Ones(1);
+    } else {
+      eig.computeFromTridiagonal(tri_diag, tri_sub, Eigen::ComputeEigenvectors);
+      theta = eig.eigenvalues()[size - 1] * scale;
+      ritz = eig.eigenvectors().col(size - 1);
     }
-    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(T);
-    theta = eig.eigenvalues()[size - 1];
-    ritz = eig.eigenvectors().col(size - 1);
     if (steps_taken) *steps_taken = size;
     // Converged: the top Ritz pair's residual is small (theta is near *an* eigenvalue) and
     // theta has stopped growing over the last steps (it rises towards the top one; near the
@@ -339,9 +352,9 @@ Status updateModelAfterCut3D(Model& model, const cutting::TetMesh& before, const
     if (a < 0 || b < 0 || (touched[a] && touched[b])) continue;
     springs.push_back({a, b, model.rest_length[s], model.stiffness[s], model.damping[s]});
   }
-  // Each (tet, edge) with both ends touched, bucketed by the edge's smaller node in
-  // increasing tet order, then each bucket sorted by the larger node (stably: an edge's tets
-  // stay in increasing order, the order buildModel sums them in).
+  // Each (tet, edge) with both ends touched, sorted by (smaller node, larger node), an edge's
+  // tets in increasing order (the order buildModel sums them in): two stable counting sorts,
+  // by the larger node, then by the smaller.
   struct EdgeOfTet {
     int b, tet;
   };
@@ -351,7 +364,7 @@ Status updateModelAfterCut3D(Model& model, const cutting::TetMesh& before, const
     const int n0 = after.T(t, 0), n1 = after.T(t, 1), n2 = after.T(t, 2), n3 = after.T(t, 3);
     if (touched[n0] + touched[n1] + touched[n2] + touched[n3] >= 2) edge_tets_of.push_back(t);
   }
-  std::vector<int> bucket(static_cast<size_t>(N1) + 1, 0);
+  std::vector<int> bucket(static_cast<size_t>(N1) + 1, 0), by_larger(static_cast<size_t>(N1) + 1, 0);
   auto forTouchedEdges = [&](auto&& f) {
     for (int t : edge_tets_of)
       for (const auto& e : kTetEdges) {
@@ -359,22 +372,23 @@ Status updateModelAfterCut3D(Model& model, const cutting::TetMesh& before, const
         if (touched[a] && touched[b]) f(t, std::min(a, b), std::max(a, b));
       }
   };
-  forTouchedEdges([&](int, int a, int) { ++bucket[a + 1]; });
-  for (int i = 0; i < N1; ++i) bucket[i + 1] += bucket[i];
+  forTouchedEdges([&](int, int a, int b) {
+    ++bucket[a + 1];
+    ++by_larger[b + 1];
+  });
+  for (int i = 0; i < N1; ++i) {
+    bucket[i + 1] += bucket[i];
+    by_larger[i + 1] += by_larger[i];
+  }
+  struct EdgeEnds {
+    int a, b, tet;
+  };
+  std::vector<EdgeEnds> by_b(static_cast<size_t>(bucket[N1]));
+  forTouchedEdges([&](int t, int a, int b) { by_b[by_larger[b]++] = {a, b, t}; });
   std::vector<EdgeOfTet> edge_tets(static_cast<size_t>(bucket[N1]));
   {
     std::vector<int> fill(bucket.begin(), bucket.end() - 1);
-    forTouchedEdges([&](int t, int a, int b) { edge_tets[fill[a]++] = {b, t}; });
-  }
-  for (int a = 0; a < N1; ++a) {
-    EdgeOfTet* const first = edge_tets.data() + bucket[a];
-    EdgeOfTet* const last = edge_tets.data() + bucket[a + 1];
-    for (EdgeOfTet* i = first + 1; i < last; ++i) {  // insertion sort: a few dozen entries
-      const EdgeOfTet e = *i;
-      EdgeOfTet* j = i;
-      for (; j > first && j[-1].b > e.b; --j) *j = j[-1];
-      *j = e;
-    }
+    for (const EdgeEnds& e : by_b) edge_tets[fill[e.a]++] = {e.b, e.tet};
   }
   int recomputed = 0;
   for (int a = 0; a < N1; ++a)
@@ -404,7 +418,7 @@ Status updateModelAfterCut3D(Model& model, const cutting::TetMesh& before, const
   int N2 = 0;
   for (int i = 0; i < N1; ++i) N2 = std::max(N2, keep[i] + 1);
   Model& m = model;
-  const Eigen::MatrixX3d old_mode = m.stability_mode;
+  const Eigen::MatrixX3d& old_mode = m.stability_mode;  // replaced only by estimate() below
   double overlap = old_mode.rows() == N0 ? 0.0 : 1.0;
   if (old_mode.rows() == N0)
     for (int i = 0; i < N0; ++i) {

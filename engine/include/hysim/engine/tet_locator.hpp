@@ -34,6 +34,7 @@ class TetLocator {
 
   Eigen::Vector3d origin_{0, 0, 0};
   double cell_ = 1.0;
+  double inv_cell_ = 1.0;  // 1 / cell_
   Eigen::Vector3i dims_{0, 0, 0};
   std::vector<int> cell_start_;  // #cells + 1
   std::vector<int> cell_tets_;
