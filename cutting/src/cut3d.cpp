@@ -50,6 +50,12 @@ class FlatMap {
  public:
   explicit FlatMap(Key empty) : empty_(empty) { rehash(64); }
   size_t size() const { return size_; }
+  // Room for n entries without growing (capacity: a power of two >= 2 n).
+  void reserve(size_t n) {
+    size_t capacity = keys_.size();
+    while (capacity < 2 * n) capacity *= 2;
+    if (capacity > keys_.size()) rehash(capacity);
+  }
   Value* find(const Key& k) {
     for (size_t i = Hash{}(k) & mask_;; i = (i + 1) & mask_) {
       if (keys_[i] == k) return &vals_[i];
@@ -201,7 +207,7 @@ struct Work {
 // even number of n's tets? XOR of a 64-bit hash of each face (by its other two nodes) over
 // the star: zero when every face occurs an even number of times; a face used once (a
 // boundary face; there are at least three around a boundary node) leaves a random non-zero
-// value (zero only with probability 2^-64). Branch-free over the six edges of each tet.
+// value (zero only with probability 2^-64).
 inline std::uint64_t mix64(std::uint64_t x) {
   x ^= x >> 30;
   x *= 0xBF58476D1CE4E5B9ull;
@@ -209,19 +215,38 @@ inline std::uint64_t mix64(std::uint64_t x) {
   x *= 0x94D049BB133111EBull;
   return x ^ (x >> 31);
 }
+int findLocal(const Tet& t, int v);
 template <class W>
 bool evenFacePairs(const W& w, int n, const std::vector<std::int32_t>& starOff, const std::vector<std::int32_t>& starTet) {
   std::uint64_t acc = 0;
   for (int s = starOff[n]; s < starOff[n + 1]; ++s) {
     const auto& tv = w.tet(starTet[s]);
-    for (const auto& e : kEdge) {
+    // The three edges of the tet without n: the faces with n, by their other two nodes.
+    for (const auto& e : kFacePairs[findLocal(tv, n)]) {
       const std::uint32_t a = static_cast<std::uint32_t>(tv[e[0]]), b = static_cast<std::uint32_t>(tv[e[1]]);
-      const std::uint64_t key = (static_cast<std::uint64_t>(std::min(a, b)) << 32) | std::max(a, b);
-      const std::uint64_t keep = (tv[e[0]] != n && tv[e[1]] != n) ? ~0ull : 0ull;
-      acc ^= mix64(key) & keep;
+      acc ^= mix64((static_cast<std::uint64_t>(std::min(a, b)) << 32) | std::max(a, b));
     }
   }
   return acc == 0;
+}
+
+// Whether radiusRatio(a, b, c, d) >= m certainly holds, from a bound without square roots
+// (false: unknown). q* = 72 V^2 / (S sqrt(P)), S the sum of the face areas, P the product in
+// radiusRatio (p, q, r: products of the lengths of opposite edges). S^2 <= sum |c_i|^2 (c_i
+// the face cross products, |c_i| = 2 area; Cauchy-Schwarz) and P <= (p^2 + q^2 + r^2)^2 / 3
+// (AM-GM), both equalities for a regular tet; so q* >= m when
+// 3 (72 V^2)^2 >= m^2 sum |c_i|^2 (p^2 + q^2 + r^2)^2, tested with m raised by 1e-6, far more
+// than the rounding of both sides. `volume`: the signed volume (same bits as radiusRatio's).
+inline bool qualityAtLeast(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, double volume, double m) {
+  if (!(m > 0)) return true;  // q* >= 0 always
+  const Vec3 ab = b - a, ac = c - a, ad = d - a, bc = c - b, bd = d - b, cd = d - c;
+  const double s2 = ab.cross(ac).squaredNorm() + ab.cross(ad).squaredNorm() + ac.cross(ad).squaredNorm() +
+                    bc.cross(bd).squaredNorm();
+  const double pqr = ab.squaredNorm() * cd.squaredNorm() + ac.squaredNorm() * bd.squaredNorm() +
+                     ad.squaredNorm() * bc.squaredNorm();
+  const double v2 = 72.0 * volume * volume;
+  const double mm = m * (1 + 1e-6);
+  return 3.0 * v2 * v2 >= mm * mm * s2 * pqr * pqr;
 }
 
 int findLocal(const Tet& t, int v) {
@@ -287,11 +312,14 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
     }
     const std::int32_t* T0c[4] = {input.T.col(0).data(), input.T.col(1).data(), input.T.col(2).data(),
                                   input.T.col(3).data()};
-    for (int t = 0; t < M0; ++t) {
-      if ((sideBits[T0c[0][t]] | sideBits[T0c[1][t]] | sideBits[T0c[2][t]] | sideBits[T0c[3][t]]) != 3) continue;
-      crossedTets.push_back(t);
+    for (int t = 0; t < M0; ++t)
+      if ((sideBits[T0c[0][t]] | sideBits[T0c[1][t]] | sideBits[T0c[2][t]] | sideBits[T0c[3][t]]) == 3)
+        crossedTets.push_back(t);
+    edgeIndex.reserve(crossedTets.size());  // about as many crossed edges as crossed tets
+    for (const int t : crossedTets) {
+      const std::int32_t tv[4] = {T0c[0][t], T0c[1][t], T0c[2][t], T0c[3][t]};
       for (const auto& e : kEdge) {
-        const int a = input.T(t, e[0]), b = input.T(t, e[1]);
+        const int a = tv[e[0]], b = tv[e[1]];
         if (!((phi[a] > eps && phi[b] < -eps) || (phi[a] < -eps && phi[b] > eps))) continue;
         const auto key = edgeKey(a, b);
         if (!edgeIndex.tryEmplace(key, static_cast<std::int32_t>(crossed.size())).second) continue;
@@ -419,10 +447,14 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
   // min_edge_fraction of its length.
   // (The conditions are independent, so they are tested cheapest first, and each edge of n
   // once although several tets share it.)
+  // One pass over the star tests the orientation and the quality bound (qualityAtLeast);
+  // the exact q* is computed only for the tets the bound cannot clear, after the edges.
   std::vector<std::uint8_t> guardSeen(N0, 0);
-  std::vector<std::int32_t> guardNbrs;
+  std::vector<std::int32_t> guardNbrs, guardExact;
+  const double minEdge2 = options.min_edge_fraction * options.min_edge_fraction;
   auto guardOk = [&](int n, const Vec3& target) {
     const Vec3 old = w.x(n);
+    guardExact.clear();
     for (int s = starOff[n]; s < starOff[n + 1]; ++s) {
       const Tet& tv = w.tet(starTet[s]);
       Vec3 p[4], q[4];
@@ -433,6 +465,7 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
       const double v0 = signedVolume(p[0], p[1], p[2], p[3]);
       const double v1 = signedVolume(q[0], q[1], q[2], q[3]);
       if (!(v1 > 1e-3 * v0)) return false;
+      if (!qualityAtLeast(q[0], q[1], q[2], q[3], v1, options.min_quality)) guardExact.push_back(s);
     }
     guardNbrs.clear();
     bool ok = true;
@@ -442,14 +475,19 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
         guardSeen[v] = 1;
         guardNbrs.push_back(v);
         const Vec3& pv = w.x(v);
-        if ((pv - target).norm() < options.min_edge_fraction * (pv - old).norm()) {
+        // |pv - target| < f |pv - old|, decided on the squares where they are clearly apart.
+        const double a2 = (pv - target).squaredNorm(), b2 = minEdge2 * (pv - old).squaredNorm();
+        const bool shorter = a2 < b2 * (1 - 1e-9) ? true
+                             : a2 > b2 * (1 + 1e-9) ? false
+                                                    : (pv - target).norm() < options.min_edge_fraction * (pv - old).norm();
+        if (shorter) {
           ok = false;
           break;
         }
       }
     for (const int v : guardNbrs) guardSeen[v] = 0;
     if (!ok) return false;
-    for (int s = starOff[n]; s < starOff[n + 1]; ++s) {
+    for (const int s : guardExact) {
       const Tet& tv = w.tet(starTet[s]);
       Vec3 p[4], q[4];
       for (int k = 0; k < 4; ++k) {
@@ -930,7 +968,6 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
       }
     }
   }
-  FlatMap<FaceKey, std::uint8_t, FaceFlatHash> cutFaces(kNoFace);
   std::vector<std::pair<FaceKey, FaceUse>> cutFaceList;
   std::vector<std::pair<std::int32_t, std::int8_t>> cutFaceSides;  // (tet, opposite local vertex)
   // Side of a tet at a face on the cut: the signed distance of the vertex opposite the face
@@ -979,7 +1016,6 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
         if (!across) return;
       }
     }
-    cutFaces.tryEmplace(key, 1);
     cutFaceList.emplace_back(key, use);
   });
   // Deterministic order for the side records.
@@ -1018,7 +1054,12 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
     }
     std::vector<int> parent, copyOf;
     std::vector<std::int32_t> sepLocal, sepNbrs, firstTet, firstUsed;
-    std::vector<std::array<std::int32_t, 4>> facePairs;  // first tet, tet, the face's other two nodes
+    std::vector<std::array<std::int32_t, 4>> facePairs;  // first tet, tet, opposite local vertex, larger other node
+    // Cut faces by tet: bit k of cutMask[t]: the face opposite local vertex k of t is cut.
+    std::vector<std::uint8_t> cutMask(w.numTets(), 0);
+    for (const auto& [key, use] : cutFaceList)
+      for (int side = 0; side < 2; ++side) cutMask[use.tet[side]] |= static_cast<std::uint8_t>(1u << use.opposite[side]);
+    const std::int32_t numSep = w.numNodes();
     for (size_t i = 0; i < numCut; ++i) {
       const int n = cutNodes[i];
       const std::span<std::int32_t> st(cutStarTet.data() + cutStarOff[i], cutStarTet.data() + cutStarOff[i + 1]);
@@ -1030,24 +1071,25 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
       };
       // Tets sharing a face with n that is not cut are in one group: faces by the pair of
       // their other two nodes (local numbers over n's neighbours), the first tet seen for each.
+      // Local numbers of n's neighbours, given as they are met (at most 3 per tet: stride L).
       if (sepLocal.size() < static_cast<size_t>(w.numNodes())) sepLocal.resize(w.numNodes(), -1);
       sepNbrs.clear();
-      for (int t : st)
-        for (const int v : w.tet(t))
-          if (v != n && sepLocal[v] < 0) {
-            sepLocal[v] = static_cast<std::int32_t>(sepNbrs.size());
-            sepNbrs.push_back(v);
-          }
-      const size_t L = sepNbrs.size();
+      const size_t L = 3 * st.size();
       if (firstTet.size() < L * L) firstTet.resize(L * L, -1);  // all -1 between nodes
-      // Pass 1 (without data-dependent branches): each face occurrence after the first
-      // gives a pair (first tet, this tet). Pass 2: pairs not across a cut face are joined.
+      // Pass 1: each face occurrence after the first gives a pair (first tet, this tet, the
+      // local vertex opposite the face in this tet, the face's other two nodes). Pass 2:
+      // pairs not across a cut face are joined.
       firstUsed.resize(3 * st.size());
       facePairs.resize(3 * st.size());
       size_t numPairs = 0;
       for (size_t j = 0, q = 0; j < st.size(); ++j) {
         const Tet& tv = w.tet(st[j]);
         const int ln = findLocal(tv, n);
+        for (int k = 0; k < 4; ++k)
+          if (k != ln && sepLocal[tv[k]] < 0) {
+            sepLocal[tv[k]] = static_cast<std::int32_t>(sepNbrs.size());
+            sepNbrs.push_back(tv[k]);
+          }
         for (const auto& pair : kFacePairs[ln]) {
           const std::int32_t o0 = tv[pair[0]], o1 = tv[pair[1]];
           const std::int32_t a = sepLocal[o0], b = sepLocal[o1];
@@ -1055,16 +1097,17 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
           const std::int32_t first = firstTet[at];
           firstTet[at] = first < 0 ? static_cast<std::int32_t>(j) : first;
           firstUsed[q++] = at;
-          facePairs[numPairs] = {first, static_cast<std::int32_t>(j), o0, o1};
+          facePairs[numPairs] = {first, static_cast<std::int32_t>(j), 6 - ln - pair[0] - pair[1], std::max(o0, o1)};
           numPairs += first >= 0 ? 1 : 0;
         }
       }
       for (int v : sepNbrs) sepLocal[v] = -1;
       for (const std::int32_t at : firstUsed) firstTet[at] = -1;
+      // A face is cut where this tet's face opposite `opp` was found cut and is still that
+      // face: its other two nodes are not copies made since (copies are >= numSep).
       for (size_t q = 0; q < numPairs; ++q) {
-        const auto& [first, j, o0, o1] = facePairs[q];
-        // (Every cut face has its three nodes on the cut, so most faces need no lookup.)
-        if (!(on[o0] && on[o1]) || !cutFaces.contains(makeFace(n, o0, o1))) parent[find(first)] = find(j);
+        const auto& [first, j, opp, ids] = facePairs[q];
+        if (!((cutMask[st[j]] >> opp) & 1) || ids >= numSep) parent[find(first)] = find(j);
       }
       // The group of the first tet keeps n; every other group gets a copy.
       copyOf.assign(st.size(), -1);
