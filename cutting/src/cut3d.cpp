@@ -230,25 +230,6 @@ bool evenFacePairs(const W& w, int n, const std::vector<std::int32_t>& starOff, 
   return acc == 0;
 }
 
-// Whether radiusRatio(a, b, c, d) >= m certainly holds, from a bound without square roots
-// (false: unknown). q* = 72 V^2 / (S sqrt(P)), S the sum of the face areas, P the product in
-// radiusRatio (p, q, r: products of the lengths of opposite edges). S^2 <= sum |c_i|^2 (c_i
-// the face cross products, |c_i| = 2 area; Cauchy-Schwarz) and P <= (p^2 + q^2 + r^2)^2 / 3
-// (AM-GM), both equalities for a regular tet; so q* >= m when
-// 3 (72 V^2)^2 >= m^2 sum |c_i|^2 (p^2 + q^2 + r^2)^2, tested with m raised by 1e-6, far more
-// than the rounding of both sides. `volume`: the signed volume (same bits as radiusRatio's).
-inline bool qualityAtLeast(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, double volume, double m) {
-  if (!(m > 0)) return true;  // q* >= 0 always
-  const Vec3 ab = b - a, ac = c - a, ad = d - a, bc = c - b, bd = d - b, cd = d - c;
-  const double s2 = ab.cross(ac).squaredNorm() + ab.cross(ad).squaredNorm() + ac.cross(ad).squaredNorm() +
-                    bc.cross(bd).squaredNorm();
-  const double pqr = ab.squaredNorm() * cd.squaredNorm() + ac.squaredNorm() * bd.squaredNorm() +
-                     ad.squaredNorm() * bc.squaredNorm();
-  const double v2 = 72.0 * volume * volume;
-  const double mm = m * (1 + 1e-6);
-  return 3.0 * v2 * v2 >= mm * mm * s2 * pqr * pqr;
-}
-
 int findLocal(const Tet& t, int v) {
   for (int k = 0; k < 4; ++k)
     if (t[k] == v) return k;
@@ -385,9 +366,20 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
   }
   report.crossed_edges = static_cast<int>(crossed.size());
   report.crossed_elements = static_cast<int>(crossedTets.size());
-  // Ends of crossed edges: an edge whose ends are not both marked is not in edgeIndex.
-  std::vector<std::uint8_t> crossEnd(N0, 0);
-  for (const auto& ce : crossed) crossEnd[ce.a] = crossEnd[ce.b] = 1;
+  // Crossed edges by end node (CSR): the edges of n that are in edgeIndex.
+  std::vector<std::int32_t> crossOff(N0 + 1, 0), crossAt(2 * crossed.size());
+  {
+    for (const auto& ce : crossed) {
+      ++crossOff[ce.a + 1];
+      ++crossOff[ce.b + 1];
+    }
+    for (int i = 0; i < N0; ++i) crossOff[i + 1] += crossOff[i];
+    std::vector<std::int32_t> fill(crossOff.begin(), crossOff.end() - 1);
+    for (int e = 0; e < static_cast<int>(crossed.size()); ++e) {
+      crossAt[fill[crossed[e].a]++] = e;
+      crossAt[fill[crossed[e].b]++] = e;
+    }
+  }
   // Room for what the cut appends (split nodes and their tets, copies), so that the working
   // arrays are not copied as they grow (a guess; they still grow past it if needed).
   Work w(input, 4 * crossed.size() + 64, 12 * crossed.size() + 64);
@@ -447,14 +439,10 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
   // min_edge_fraction of its length.
   // (The conditions are independent, so they are tested cheapest first, and each edge of n
   // once although several tets share it.)
-  // One pass over the star tests the orientation and the quality bound (qualityAtLeast);
-  // the exact q* is computed only for the tets the bound cannot clear, after the edges.
   std::vector<std::uint8_t> guardSeen(N0, 0);
-  std::vector<std::int32_t> guardNbrs, guardExact;
-  const double minEdge2 = options.min_edge_fraction * options.min_edge_fraction;
+  std::vector<std::int32_t> guardNbrs;
   auto guardOk = [&](int n, const Vec3& target) {
     const Vec3 old = w.x(n);
-    guardExact.clear();
     for (int s = starOff[n]; s < starOff[n + 1]; ++s) {
       const Tet& tv = w.tet(starTet[s]);
       Vec3 p[4], q[4];
@@ -465,7 +453,6 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
       const double v0 = signedVolume(p[0], p[1], p[2], p[3]);
       const double v1 = signedVolume(q[0], q[1], q[2], q[3]);
       if (!(v1 > 1e-3 * v0)) return false;
-      if (!qualityAtLeast(q[0], q[1], q[2], q[3], v1, options.min_quality)) guardExact.push_back(s);
     }
     guardNbrs.clear();
     bool ok = true;
@@ -475,19 +462,14 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
         guardSeen[v] = 1;
         guardNbrs.push_back(v);
         const Vec3& pv = w.x(v);
-        // |pv - target| < f |pv - old|, decided on the squares where they are clearly apart.
-        const double a2 = (pv - target).squaredNorm(), b2 = minEdge2 * (pv - old).squaredNorm();
-        const bool shorter = a2 < b2 * (1 - 1e-9) ? true
-                             : a2 > b2 * (1 + 1e-9) ? false
-                                                    : (pv - target).norm() < options.min_edge_fraction * (pv - old).norm();
-        if (shorter) {
+        if ((pv - target).norm() < options.min_edge_fraction * (pv - old).norm()) {
           ok = false;
           break;
         }
       }
     for (const int v : guardNbrs) guardSeen[v] = 0;
     if (!ok) return false;
-    for (const int s : guardExact) {
+    for (int s = starOff[n]; s < starOff[n + 1]; ++s) {
       const Tet& tv = w.tet(starTet[s]);
       Vec3 p[4], q[4];
       for (int k = 0; k < 4; ++k) {
@@ -719,14 +701,7 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
       ++report.snapped_nodes;
       if (boundary) ++report.boundary_snaps;
       if (ridgeSnap) ++report.ridge_snaps;
-      for (int s = starOff[n]; s < starOff[n + 1]; ++s) {
-        const Tet tv = w.tet(starTet[s]);
-        for (int k = 0; k < 4; ++k) {
-          if (tv[k] == n || !crossEnd[tv[k]]) continue;
-          const std::int32_t* it = edgeIndex.find(edgeKey(n, tv[k]));
-          if (it) crossed[*it].alive = false;
-        }
-      }
+      for (int x = crossOff[n]; x < crossOff[n + 1]; ++x) crossed[crossAt[x]].alive = false;
     }
   }
 
@@ -757,14 +732,9 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
       tried[n] = 1;
       // |phi| that puts every crossing on n's edges at >= f of the edge.
       double need = 0;
-      for (int s = starOff[n]; s < starOff[n + 1]; ++s) {
-        const Tet tv = w.tet(starTet[s]);
-        for (int k = 0; k < 4; ++k) {
-          if (tv[k] == n || !crossEnd[tv[k]]) continue;
-          const std::int32_t* it = edgeIndex.find(edgeKey(n, tv[k]));
-          if (!it || !crossed[*it].alive) continue;
-          need = std::max(need, f / (1.0 - f) * std::abs(phi[tv[k]]));
-        }
+      for (int x = crossOff[n]; x < crossOff[n + 1]; ++x) {
+        const CrossedEdge& ce = crossed[crossAt[x]];
+        if (ce.alive) need = std::max(need, f / (1.0 - f) * std::abs(phi[ce.a == n ? ce.b : ce.a]));
       }
       const double sgn = phi[n] > 0 ? 1.0 : -1.0;
       const double have = std::abs(phi[n]);
@@ -814,15 +784,9 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
         if (!guardOk(n, target)) continue;
         w.setX(n, target);
         phi[n] = pn.dot(target - pp);
-        for (int s = starOff[n]; s < starOff[n + 1]; ++s) {
-          const Tet tv = w.tet(starTet[s]);
-          for (int k = 0; k < 4; ++k) {
-            if (tv[k] == n || !crossEnd[tv[k]]) continue;
-            const std::int32_t* it = edgeIndex.find(edgeKey(n, tv[k]));
-            if (!it) continue;
-            CrossedEdge& ce = crossed[*it];
-            ce.t = phi[ce.a] / (phi[ce.a] - phi[ce.b]);
-          }
+        for (int x = crossOff[n]; x < crossOff[n + 1]; ++x) {
+          CrossedEdge& ce = crossed[crossAt[x]];
+          ce.t = phi[ce.a] / (phi[ce.a] - phi[ce.b]);
         }
         moved.push_back(n);
         ++report.away_moves;
@@ -848,17 +812,11 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
       on[n] = 1;
       onNodes.push_back(n);
       ++report.routed_nodes;
-      for (int s = starOff[n]; s < starOff[n + 1]; ++s) {
-        const Tet tv = w.tet(starTet[s]);
-        for (int k = 0; k < 4; ++k) {
-          if (tv[k] == n || !crossEnd[tv[k]]) continue;
-          // Edges crossed nearer n than their other end now end on the cut; the others
-          // (crossed nearer the other end, which may itself be routed through) stay split.
-          const std::int32_t* it = edgeIndex.find(edgeKey(n, tv[k]));
-          if (!it) continue;
-          CrossedEdge& ce = crossed[*it];
-          if ((ce.a == n ? ce.t : 1.0 - ce.t) <= 0.5) ce.alive = false;
-        }
+      for (int x = crossOff[n]; x < crossOff[n + 1]; ++x) {
+        // Edges crossed nearer n than their other end now end on the cut; the others
+        // (crossed nearer the other end, which may itself be routed through) stay split.
+        CrossedEdge& ce = crossed[crossAt[x]];
+        if ((ce.a == n ? ce.t : 1.0 - ce.t) <= 0.5) ce.alive = false;
       }
     }
     // Two routed nodes on opposite sides: their edge is split after all (else one tet would
