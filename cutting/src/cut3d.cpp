@@ -993,25 +993,29 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
     std::vector<std::int32_t> slot(w.numNodes(), -1);
     for (size_t i = 0; i < cutNodes.size(); ++i) slot[cutNodes[i]] = static_cast<std::int32_t>(i);
     // Stars of the cut nodes within the local tets (CSR, each ascending: filled from the
-    // local tets in ascending order).
+    // local tets in ascending order). One pass over the local tets lists (cut node, tet).
     const size_t numCut = cutNodes.size();
-    std::vector<std::int32_t> cutStarOff(numCut + 1, 0), cutStarTet, localSorted;
-    localSorted.reserve(local.size());
-    for (int t = 0; t < static_cast<int>(inLocal.size()); ++t)
-      if (inLocal[t]) localSorted.push_back(t);
-    for (int t : localSorted)
-      for (const int v : w.tet(t))
-        if (slot[v] >= 0) ++cutStarOff[slot[v] + 1];
+    std::vector<std::int32_t> cutStarOff(numCut + 1, 0), cutStarTet;
+    std::vector<std::array<std::int32_t, 2>> incidence;
+    incidence.reserve(4 * local.size());
+    for (int t = 0; t < static_cast<int>(inLocal.size()); ++t) {
+      if (!inLocal[t]) continue;
+      for (const int v : w.tet(t)) {
+        const std::int32_t sl = slot[v];
+        if (sl < 0) continue;
+        ++cutStarOff[sl + 1];
+        incidence.push_back({sl, t});
+      }
+    }
     for (size_t i = 0; i < numCut; ++i) cutStarOff[i + 1] += cutStarOff[i];
     cutStarTet.resize(cutStarOff[numCut]);
     {
       std::vector<std::int32_t> fill(cutStarOff.begin(), cutStarOff.end() - 1);
-      for (int t : localSorted)
-        for (const int v : w.tet(t))
-          if (slot[v] >= 0) cutStarTet[fill[slot[v]]++] = t;
+      for (const auto& [sl, t] : incidence) cutStarTet[fill[sl]++] = t;
     }
     std::vector<int> parent, copyOf;
     std::vector<std::int32_t> sepLocal, sepNbrs, firstTet, firstUsed;
+    std::vector<std::int8_t> localOfN;
     std::vector<std::array<std::int32_t, 4>> facePairs;  // first tet, tet, opposite local vertex, larger other node
     // Cut faces by tet: bit k of cutMask[t]: the face opposite local vertex k of t is cut.
     std::vector<std::uint8_t> cutMask(w.numTets(), 0);
@@ -1039,10 +1043,12 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
       // pairs not across a cut face are joined.
       firstUsed.resize(3 * st.size());
       facePairs.resize(3 * st.size());
+      localOfN.resize(st.size());  // n's local index in each tet of its star
       size_t numPairs = 0;
       for (size_t j = 0, q = 0; j < st.size(); ++j) {
         const Tet& tv = w.tet(st[j]);
         const int ln = findLocal(tv, n);
+        localOfN[j] = static_cast<std::int8_t>(ln);
         for (int k = 0; k < 4; ++k)
           if (k != ln && sepLocal[tv[k]] < 0) {
             sepLocal[tv[k]] = static_cast<std::int32_t>(sepNbrs.size());
@@ -1094,7 +1100,7 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
           ++report.duplicated_nodes;
         }
         Tet tv = w.tet(st[j]);
-        tv[findLocal(tv, n)] = copyOf[g];
+        tv[localOfN[j]] = copyOf[g];
         w.setTet(st[j], tv);
       }
     }
