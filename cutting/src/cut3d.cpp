@@ -50,6 +50,12 @@ class FlatMap {
  public:
   explicit FlatMap(Key empty) : empty_(empty) { rehash(64); }
   size_t size() const { return size_; }
+  // Room for n entries without growing (capacity: a power of two >= 2 n).
+  void reserve(size_t n) {
+    size_t capacity = keys_.size();
+    while (capacity < 2 * n) capacity *= 2;
+    if (capacity > keys_.size()) rehash(capacity);
+  }
   Value* find(const Key& k) {
     for (size_t i = Hash{}(k) & mask_;; i = (i + 1) & mask_) {
       if (keys_[i] == k) return &vals_[i];
@@ -201,7 +207,7 @@ struct Work {
 // even number of n's tets? XOR of a 64-bit hash of each face (by its other two nodes) over
 // the star: zero when every face occurs an even number of times; a face used once (a
 // boundary face; there are at least three around a boundary node) leaves a random non-zero
-// value (zero only with probability 2^-64). Branch-free over the six edges of each tet.
+// value (zero only with probability 2^-64).
 inline std::uint64_t mix64(std::uint64_t x) {
   x ^= x >> 30;
   x *= 0xBF58476D1CE4E5B9ull;
@@ -209,16 +215,16 @@ inline std::uint64_t mix64(std::uint64_t x) {
   x *= 0x94D049BB133111EBull;
   return x ^ (x >> 31);
 }
+int findLocal(const Tet& t, int v);
 template <class W>
 bool evenFacePairs(const W& w, int n, const std::vector<std::int32_t>& starOff, const std::vector<std::int32_t>& starTet) {
   std::uint64_t acc = 0;
   for (int s = starOff[n]; s < starOff[n + 1]; ++s) {
     const auto& tv = w.tet(starTet[s]);
-    for (const auto& e : kEdge) {
+    // The three edges of the tet without n: the faces with n, by their other two nodes.
+    for (const auto& e : kFacePairs[findLocal(tv, n)]) {
       const std::uint32_t a = static_cast<std::uint32_t>(tv[e[0]]), b = static_cast<std::uint32_t>(tv[e[1]]);
-      const std::uint64_t key = (static_cast<std::uint64_t>(std::min(a, b)) << 32) | std::max(a, b);
-      const std::uint64_t keep = (tv[e[0]] != n && tv[e[1]] != n) ? ~0ull : 0ull;
-      acc ^= mix64(key) & keep;
+      acc ^= mix64((static_cast<std::uint64_t>(std::min(a, b)) << 32) | std::max(a, b));
     }
   }
   return acc == 0;
@@ -287,11 +293,14 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
     }
     const std::int32_t* T0c[4] = {input.T.col(0).data(), input.T.col(1).data(), input.T.col(2).data(),
                                   input.T.col(3).data()};
-    for (int t = 0; t < M0; ++t) {
-      if ((sideBits[T0c[0][t]] | sideBits[T0c[1][t]] | sideBits[T0c[2][t]] | sideBits[T0c[3][t]]) != 3) continue;
-      crossedTets.push_back(t);
+    for (int t = 0; t < M0; ++t)
+      if ((sideBits[T0c[0][t]] | sideBits[T0c[1][t]] | sideBits[T0c[2][t]] | sideBits[T0c[3][t]]) == 3)
+        crossedTets.push_back(t);
+    edgeIndex.reserve(crossedTets.size());  // about as many crossed edges as crossed tets
+    for (const int t : crossedTets) {
+      const std::int32_t tv[4] = {T0c[0][t], T0c[1][t], T0c[2][t], T0c[3][t]};
       for (const auto& e : kEdge) {
-        const int a = input.T(t, e[0]), b = input.T(t, e[1]);
+        const int a = tv[e[0]], b = tv[e[1]];
         if (!((phi[a] > eps && phi[b] < -eps) || (phi[a] < -eps && phi[b] > eps))) continue;
         const auto key = edgeKey(a, b);
         if (!edgeIndex.tryEmplace(key, static_cast<std::int32_t>(crossed.size())).second) continue;
@@ -357,9 +366,20 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
   }
   report.crossed_edges = static_cast<int>(crossed.size());
   report.crossed_elements = static_cast<int>(crossedTets.size());
-  // Ends of crossed edges: an edge whose ends are not both marked is not in edgeIndex.
-  std::vector<std::uint8_t> crossEnd(N0, 0);
-  for (const auto& ce : crossed) crossEnd[ce.a] = crossEnd[ce.b] = 1;
+  // Crossed edges by end node (CSR): the edges of n that are in edgeIndex.
+  std::vector<std::int32_t> crossOff(N0 + 1, 0), crossAt(2 * crossed.size());
+  {
+    for (const auto& ce : crossed) {
+      ++crossOff[ce.a + 1];
+      ++crossOff[ce.b + 1];
+    }
+    for (int i = 0; i < N0; ++i) crossOff[i + 1] += crossOff[i];
+    std::vector<std::int32_t> fill(crossOff.begin(), crossOff.end() - 1);
+    for (int e = 0; e < static_cast<int>(crossed.size()); ++e) {
+      crossAt[fill[crossed[e].a]++] = e;
+      crossAt[fill[crossed[e].b]++] = e;
+    }
+  }
   // Room for what the cut appends (split nodes and their tets, copies), so that the working
   // arrays are not copied as they grow (a guess; they still grow past it if needed).
   Work w(input, 4 * crossed.size() + 64, 12 * crossed.size() + 64);
@@ -681,14 +701,7 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
       ++report.snapped_nodes;
       if (boundary) ++report.boundary_snaps;
       if (ridgeSnap) ++report.ridge_snaps;
-      for (int s = starOff[n]; s < starOff[n + 1]; ++s) {
-        const Tet tv = w.tet(starTet[s]);
-        for (int k = 0; k < 4; ++k) {
-          if (tv[k] == n || !crossEnd[tv[k]]) continue;
-          const std::int32_t* it = edgeIndex.find(edgeKey(n, tv[k]));
-          if (it) crossed[*it].alive = false;
-        }
-      }
+      for (int x = crossOff[n]; x < crossOff[n + 1]; ++x) crossed[crossAt[x]].alive = false;
     }
   }
 
@@ -719,14 +732,9 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
       tried[n] = 1;
       // |phi| that puts every crossing on n's edges at >= f of the edge.
       double need = 0;
-      for (int s = starOff[n]; s < starOff[n + 1]; ++s) {
-        const Tet tv = w.tet(starTet[s]);
-        for (int k = 0; k < 4; ++k) {
-          if (tv[k] == n || !crossEnd[tv[k]]) continue;
-          const std::int32_t* it = edgeIndex.find(edgeKey(n, tv[k]));
-          if (!it || !crossed[*it].alive) continue;
-          need = std::max(need, f / (1.0 - f) * std::abs(phi[tv[k]]));
-        }
+      for (int x = crossOff[n]; x < crossOff[n + 1]; ++x) {
+        const CrossedEdge& ce = crossed[crossAt[x]];
+        if (ce.alive) need = std::max(need, f / (1.0 - f) * std::abs(phi[ce.a == n ? ce.b : ce.a]));
       }
       const double sgn = phi[n] > 0 ? 1.0 : -1.0;
       const double have = std::abs(phi[n]);
@@ -776,15 +784,9 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
         if (!guardOk(n, target)) continue;
         w.setX(n, target);
         phi[n] = pn.dot(target - pp);
-        for (int s = starOff[n]; s < starOff[n + 1]; ++s) {
-          const Tet tv = w.tet(starTet[s]);
-          for (int k = 0; k < 4; ++k) {
-            if (tv[k] == n || !crossEnd[tv[k]]) continue;
-            const std::int32_t* it = edgeIndex.find(edgeKey(n, tv[k]));
-            if (!it) continue;
-            CrossedEdge& ce = crossed[*it];
-            ce.t = phi[ce.a] / (phi[ce.a] - phi[ce.b]);
-          }
+        for (int x = crossOff[n]; x < crossOff[n + 1]; ++x) {
+          CrossedEdge& ce = crossed[crossAt[x]];
+          ce.t = phi[ce.a] / (phi[ce.a] - phi[ce.b]);
         }
         moved.push_back(n);
         ++report.away_moves;
@@ -810,17 +812,11 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
       on[n] = 1;
       onNodes.push_back(n);
       ++report.routed_nodes;
-      for (int s = starOff[n]; s < starOff[n + 1]; ++s) {
-        const Tet tv = w.tet(starTet[s]);
-        for (int k = 0; k < 4; ++k) {
-          if (tv[k] == n || !crossEnd[tv[k]]) continue;
-          // Edges crossed nearer n than their other end now end on the cut; the others
-          // (crossed nearer the other end, which may itself be routed through) stay split.
-          const std::int32_t* it = edgeIndex.find(edgeKey(n, tv[k]));
-          if (!it) continue;
-          CrossedEdge& ce = crossed[*it];
-          if ((ce.a == n ? ce.t : 1.0 - ce.t) <= 0.5) ce.alive = false;
-        }
+      for (int x = crossOff[n]; x < crossOff[n + 1]; ++x) {
+        // Edges crossed nearer n than their other end now end on the cut; the others
+        // (crossed nearer the other end, which may itself be routed through) stay split.
+        CrossedEdge& ce = crossed[crossAt[x]];
+        if ((ce.a == n ? ce.t : 1.0 - ce.t) <= 0.5) ce.alive = false;
       }
     }
     // Two routed nodes on opposite sides: their edge is split after all (else one tet would
@@ -930,7 +926,6 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
       }
     }
   }
-  FlatMap<FaceKey, std::uint8_t, FaceFlatHash> cutFaces(kNoFace);
   std::vector<std::pair<FaceKey, FaceUse>> cutFaceList;
   std::vector<std::pair<std::int32_t, std::int8_t>> cutFaceSides;  // (tet, opposite local vertex)
   // Side of a tet at a face on the cut: the signed distance of the vertex opposite the face
@@ -979,7 +974,6 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
         if (!across) return;
       }
     }
-    cutFaces.tryEmplace(key, 1);
     cutFaceList.emplace_back(key, use);
   });
   // Deterministic order for the side records.
@@ -999,26 +993,35 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
     std::vector<std::int32_t> slot(w.numNodes(), -1);
     for (size_t i = 0; i < cutNodes.size(); ++i) slot[cutNodes[i]] = static_cast<std::int32_t>(i);
     // Stars of the cut nodes within the local tets (CSR, each ascending: filled from the
-    // local tets in ascending order).
+    // local tets in ascending order). One pass over the local tets lists (cut node, tet).
     const size_t numCut = cutNodes.size();
-    std::vector<std::int32_t> cutStarOff(numCut + 1, 0), cutStarTet, localSorted;
-    localSorted.reserve(local.size());
-    for (int t = 0; t < static_cast<int>(inLocal.size()); ++t)
-      if (inLocal[t]) localSorted.push_back(t);
-    for (int t : localSorted)
-      for (const int v : w.tet(t))
-        if (slot[v] >= 0) ++cutStarOff[slot[v] + 1];
+    std::vector<std::int32_t> cutStarOff(numCut + 1, 0), cutStarTet;
+    std::vector<std::array<std::int32_t, 2>> incidence;
+    incidence.reserve(4 * local.size());
+    for (int t = 0; t < static_cast<int>(inLocal.size()); ++t) {
+      if (!inLocal[t]) continue;
+      for (const int v : w.tet(t)) {
+        const std::int32_t sl = slot[v];
+        if (sl < 0) continue;
+        ++cutStarOff[sl + 1];
+        incidence.push_back({sl, t});
+      }
+    }
     for (size_t i = 0; i < numCut; ++i) cutStarOff[i + 1] += cutStarOff[i];
     cutStarTet.resize(cutStarOff[numCut]);
     {
       std::vector<std::int32_t> fill(cutStarOff.begin(), cutStarOff.end() - 1);
-      for (int t : localSorted)
-        for (const int v : w.tet(t))
-          if (slot[v] >= 0) cutStarTet[fill[slot[v]]++] = t;
+      for (const auto& [sl, t] : incidence) cutStarTet[fill[sl]++] = t;
     }
     std::vector<int> parent, copyOf;
     std::vector<std::int32_t> sepLocal, sepNbrs, firstTet, firstUsed;
-    std::vector<std::array<std::int32_t, 4>> facePairs;  // first tet, tet, the face's other two nodes
+    std::vector<std::int8_t> localOfN;
+    std::vector<std::array<std::int32_t, 4>> facePairs;  // first tet, tet, opposite local vertex, larger other node
+    // Cut faces by tet: bit k of cutMask[t]: the face opposite local vertex k of t is cut.
+    std::vector<std::uint8_t> cutMask(w.numTets(), 0);
+    for (const auto& [key, use] : cutFaceList)
+      for (int side = 0; side < 2; ++side) cutMask[use.tet[side]] |= static_cast<std::uint8_t>(1u << use.opposite[side]);
+    const std::int32_t numSep = w.numNodes();
     for (size_t i = 0; i < numCut; ++i) {
       const int n = cutNodes[i];
       const std::span<std::int32_t> st(cutStarTet.data() + cutStarOff[i], cutStarTet.data() + cutStarOff[i + 1]);
@@ -1030,24 +1033,27 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
       };
       // Tets sharing a face with n that is not cut are in one group: faces by the pair of
       // their other two nodes (local numbers over n's neighbours), the first tet seen for each.
+      // Local numbers of n's neighbours, given as they are met (at most 3 per tet: stride L).
       if (sepLocal.size() < static_cast<size_t>(w.numNodes())) sepLocal.resize(w.numNodes(), -1);
       sepNbrs.clear();
-      for (int t : st)
-        for (const int v : w.tet(t))
-          if (v != n && sepLocal[v] < 0) {
-            sepLocal[v] = static_cast<std::int32_t>(sepNbrs.size());
-            sepNbrs.push_back(v);
-          }
-      const size_t L = sepNbrs.size();
+      const size_t L = 3 * st.size();
       if (firstTet.size() < L * L) firstTet.resize(L * L, -1);  // all -1 between nodes
-      // Pass 1 (without data-dependent branches): each face occurrence after the first
-      // gives a pair (first tet, this tet). Pass 2: pairs not across a cut face are joined.
+      // Pass 1: each face occurrence after the first gives a pair (first tet, this tet, the
+      // local vertex opposite the face in this tet, the face's other two nodes). Pass 2:
+      // pairs not across a cut face are joined.
       firstUsed.resize(3 * st.size());
       facePairs.resize(3 * st.size());
+      localOfN.resize(st.size());  // n's local index in each tet of its star
       size_t numPairs = 0;
       for (size_t j = 0, q = 0; j < st.size(); ++j) {
         const Tet& tv = w.tet(st[j]);
         const int ln = findLocal(tv, n);
+        localOfN[j] = static_cast<std::int8_t>(ln);
+        for (int k = 0; k < 4; ++k)
+          if (k != ln && sepLocal[tv[k]] < 0) {
+            sepLocal[tv[k]] = static_cast<std::int32_t>(sepNbrs.size());
+            sepNbrs.push_back(tv[k]);
+          }
         for (const auto& pair : kFacePairs[ln]) {
           const std::int32_t o0 = tv[pair[0]], o1 = tv[pair[1]];
           const std::int32_t a = sepLocal[o0], b = sepLocal[o1];
@@ -1055,16 +1061,17 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
           const std::int32_t first = firstTet[at];
           firstTet[at] = first < 0 ? static_cast<std::int32_t>(j) : first;
           firstUsed[q++] = at;
-          facePairs[numPairs] = {first, static_cast<std::int32_t>(j), o0, o1};
+          facePairs[numPairs] = {first, static_cast<std::int32_t>(j), 6 - ln - pair[0] - pair[1], std::max(o0, o1)};
           numPairs += first >= 0 ? 1 : 0;
         }
       }
       for (int v : sepNbrs) sepLocal[v] = -1;
       for (const std::int32_t at : firstUsed) firstTet[at] = -1;
+      // A face is cut where this tet's face opposite `opp` was found cut and is still that
+      // face: its other two nodes are not copies made since (copies are >= numSep).
       for (size_t q = 0; q < numPairs; ++q) {
-        const auto& [first, j, o0, o1] = facePairs[q];
-        // (Every cut face has its three nodes on the cut, so most faces need no lookup.)
-        if (!(on[o0] && on[o1]) || !cutFaces.contains(makeFace(n, o0, o1))) parent[find(first)] = find(j);
+        const auto& [first, j, opp, ids] = facePairs[q];
+        if (!((cutMask[st[j]] >> opp) & 1) || ids >= numSep) parent[find(first)] = find(j);
       }
       // The group of the first tet keeps n; every other group gets a copy.
       copyOf.assign(st.size(), -1);
@@ -1093,7 +1100,7 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
           ++report.duplicated_nodes;
         }
         Tet tv = w.tet(st[j]);
-        tv[findLocal(tv, n)] = copyOf[g];
+        tv[localOfN[j]] = copyOf[g];
         w.setTet(st[j], tv);
       }
     }
