@@ -105,5 +105,42 @@ TEST(ShaveQuality, DumpedPassOverRoughBoundariesKeepsAQuarterOfTheInitialQuality
   EXPECT_LT(computeStats(o->mesh).q_min, 0.25 * q0);
 }
 
+// Pass 41 of the default scene (rest mesh before the pass and its sweep, from
+// `hysim run scenes/default.yaml --dump-cuts DIR` on main, state hash 8ae57a91dd3daf84): the sweep passes
+// 0.05 mm from a boundary node and leaves a fan of flat tets (two boundary faces each: one in
+// the cut, one on the outer boundary) between the cut and that node, plus a thin neck holding
+// a chip. No single-tet peel, collapse or move repairs them (each peel alone leaves a pinched
+// edge); before flap peeling (flap_peel.cpp) the kept tissue's q*_min was 0.0044 (0.04x).
+TEST(ShaveQuality, ThinFlapsBetweenTheSweepAndTheBoundaryArePeeledAsAGroup) {
+  const std::string dir = std::string(HYSIM_TEST_DATA_DIR) + "/cutting/";
+  auto mesh = readTetMesh(dir + "shave_pass41_mesh.msh");
+  ASSERT_TRUE(mesh.ok()) << mesh.error();
+  auto tris = readTriMesh(dir + "shave_pass41_surface.msh");
+  ASSERT_TRUE(tris.ok()) << tris.error();
+  auto surface = CutSurface::triangles(tris->X, tris->F);
+  ASSERT_TRUE(surface.ok()) << surface.error();
+  const double q0 = 0.1062;  // assets/uterus_myoma.msh
+  auto r = cut3d(*mesh, *surface, Cut3DOptions{});
+  ASSERT_TRUE(r.ok()) << r.error();
+  const Status v = validate(r->mesh);
+  ASSERT_TRUE(v.ok()) << v.error();
+  EXPECT_GT(r->report.flap_peeled, 0);
+  const TetMesh kept = withoutChips(r->mesh);
+  const double q = computeStats(kept).q_min;
+  std::printf("pass 41: q*_min %.4f (%.2fx the initial), %d tets in flaps\n", q, q / q0, r->report.flap_peeled);
+  EXPECT_GE(q, 0.25 * q0);
+  EXPECT_LE(r->mesh.numTets(), 1.2 * mesh->numTets());
+  // Flaps are thin: the volume lost (peeling, chips included) stays small.
+  EXPECT_NEAR(totalVolume(r->mesh), totalVolume(*mesh), 2e-4 * totalVolume(*mesh));
+  // Without flap peeling the mesh is valid but the flap stays.
+  Cut3DOptions off;
+  off.optimize.flap_quality = 0;
+  auto o = cut3d(*mesh, *surface, off);
+  ASSERT_TRUE(o.ok()) << o.error();
+  EXPECT_TRUE(validate(o->mesh).ok());
+  EXPECT_EQ(o->report.flap_peeled, 0);
+  EXPECT_LT(computeStats(withoutChips(o->mesh)).q_min, 0.25 * q0);
+}
+
 }  // namespace
 }  // namespace hysim::cutting
