@@ -20,7 +20,10 @@
 //    faces, every face at most twice, the boundary around it one closed loop) or loses all
 //    its tets. A node whose remaining star falls apart into pieces is repaired by removing
 //    every piece but the largest (by volume) too, if the volume limits allow (at most
-//    flap_max_tets tets in the group);
+//    flap_max_tets tets in the group). A node whose star was already not a manifold one
+//    before (earlier cuts pinched it) is accepted as long as it stays so (no worse); a node
+//    where the flap would open a hole through the surface (one piece, two boundary loops)
+//    keeps the flap's tets at it, unless the worst tet is among them;
 //  - the group is no bridge between two large parts: the tets next to it stay connected
 //    (walks of at most 256 tets); a closed piece that hung on the group only (a chip the
 //    sweep almost cut off, held by a neck this thin) is freed, as the cut frees chips.
@@ -237,7 +240,7 @@ void peelFlaps(const TetMesh& mesh, const CutRegion& region, const std::vector<s
     return count;
   };
 
-  std::vector<std::int32_t> group, groupNodes, rim;
+  std::vector<std::int32_t> group, groupNodes, rim, restored;
   std::vector<double> pieceVolume;
   std::vector<std::int32_t> fanTets, walked, allWalked;
   std::vector<int> mark;  // #T walk marks, allocated when first needed
@@ -256,6 +259,17 @@ void peelFlaps(const TetMesh& mesh, const CutRegion& region, const std::vector<s
       for (int f = 0; f < 4 && !onBoundary; ++f) onBoundary = across(t, f) < 0;
     }
     if (!onBoundary || vol > groupLimit || vol > passLeft) continue;
+    int worstTet = group[0];
+    {
+      double wq = 2;
+      for (int t : group) {
+        const double q = radiusRatio(pos(mesh.T(t, 0)), pos(mesh.T(t, 1)), pos(mesh.T(t, 2)), pos(mesh.T(t, 3)));
+        if (q < wq) {
+          wq = q;
+          worstTet = t;
+        }
+      }
+    }
     for (int t : group) gone[t] = 1;
     // Check the stars of the group's nodes; repair pinched nodes by removing the smaller pieces.
     bool ok = true;
@@ -298,8 +312,34 @@ void peelFlaps(const TetMesh& mesh, const CutRegion& region, const std::vector<s
           continue;
         }
         if (count < 0) {
-          ok = false;
-          break;
+          // A node whose star was already not a manifold one before (earlier cuts left it
+          // pinched) and stays so: the flap does not make it worse.
+          restored.clear();
+          for (int t : group)
+            if (has(t, v)) {
+              restored.push_back(t);
+              gone[t] = 0;
+            }
+          liveStar(v);
+          const int before = pieces(v);
+          for (int t : restored) gone[t] = 1;
+          if (before == -1) continue;
+          // The flap would open a hole through the surface around v (its star keeps one
+          // piece, but the boundary around v becomes two loops): keep the flap's tets at v
+          // where the worst tet is not among them and the rest is still a flap.
+          bool worstKept = false;
+          for (int t : restored) worstKept = worstKept || t == worstTet;
+          if (worstKept || restored.size() == group.size()) {
+              ok = false;
+            break;
+          }
+          for (int t : restored) {
+            gone[t] = 0;
+            vol -= volume(t);
+            group.erase(std::find(group.begin(), group.end(), t));
+          }
+          grew = true;
+          continue;
         }
         if (count <= 1) continue;
         pieceVolume.assign(around.size(), 0.0);

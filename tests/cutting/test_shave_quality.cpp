@@ -142,5 +142,31 @@ TEST(ShaveQuality, ThinFlapsBetweenTheSweepAndTheBoundaryArePeeledAsAGroup) {
   EXPECT_LT(computeStats(withoutChips(o->mesh)).q_min, 0.25 * q0);
 }
 
+
+// Pass 45 of the default scene (from `hysim run scenes/default.yaml --dump-cuts DIR` on the
+// flap-quality branch, state hash 9545b076d460d431): the poor flap (q* 0.0021) touches a
+// boundary node whose star earlier cuts had already left pinched (not a manifold star before
+// the flap is removed). Removing the flap does not make that node worse, so it is peeled;
+// before, such a flap was refused and the pass left q*_min 0.0021 (0.02x).
+TEST(ShaveQuality, FlapsAtANodeAlreadyPinchedBeforeThePassArePeeled) {
+  const std::string dir = std::string(HYSIM_TEST_DATA_DIR) + "/cutting/";
+  auto mesh = readTetMesh(dir + "shave_pass45_mesh.msh");
+  ASSERT_TRUE(mesh.ok()) << mesh.error();
+  auto tris = readTriMesh(dir + "shave_pass45_surface.msh");
+  ASSERT_TRUE(tris.ok()) << tris.error();
+  auto surface = CutSurface::triangles(tris->X, tris->F);
+  ASSERT_TRUE(surface.ok()) << surface.error();
+  const double q0 = 0.1062;  // assets/uterus_myoma.msh
+  auto r = cut3d(*mesh, *surface, Cut3DOptions{});
+  ASSERT_TRUE(r.ok()) << r.error();
+  const Status v = validate(r->mesh);
+  ASSERT_TRUE(v.ok()) << v.error();
+  EXPECT_GT(r->report.flap_peeled, 0);
+  const double q = computeStats(withoutChips(r->mesh)).q_min;
+  std::printf("pass 45: q*_min %.4f (%.2fx the initial), %d tets in flaps\n", q, q / q0, r->report.flap_peeled);
+  EXPECT_GE(q, 0.25 * q0);
+  EXPECT_LE(r->mesh.numTets(), 1.2 * mesh->numTets());
+  EXPECT_NEAR(totalVolume(r->mesh), totalVolume(*mesh), 2e-4 * totalVolume(*mesh));
+}
 }  // namespace
 }  // namespace hysim::cutting
