@@ -12,7 +12,8 @@
 // tissue this thin between the loop and the surface is vaporised.
 //
 // Rule: candidates are the live tets with q* below flap_quality that have a node within
-// flap_rings edge steps of the seeds (what the cut touched). Candidates sharing faces form
+// flap_rings edge steps of the seeds (what the cut touched, and every node on the cut).
+// Candidates sharing faces form
 // groups; a group with at least one boundary face is removed when
 //  - its volume is at most flap_group_volume x a regular tet with the cut's local edge, and
 //    all removed flaps of this cut together at most flap_pass_volume x that;
@@ -100,6 +101,13 @@ void peelFlaps(const TetMesh& mesh, const CutRegion& region, const std::vector<s
   std::vector<std::int32_t> frontier, next, nearNodes;
   for (int n : seeds)
     if (n >= 0 && n < N && ring[n] < 0) {
+      ring[n] = 0;
+      frontier.push_back(n);
+      nearNodes.push_back(n);
+    }
+  // Nodes on the cut that the cut did not touch (it passed within eps of them) are seeds too.
+  for (int n = 0; n < N && n < static_cast<int>(region.on_cut.size()); ++n)
+    if (region.on_cut[n] && ring[n] < 0 && off[n + 1] > off[n]) {
       ring[n] = 0;
       frontier.push_back(n);
       nearNodes.push_back(n);

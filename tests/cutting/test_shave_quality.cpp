@@ -168,5 +168,30 @@ TEST(ShaveQuality, FlapsAtANodeAlreadyPinchedBeforeThePassArePeeled) {
   EXPECT_LE(r->mesh.numTets(), 1.2 * mesh->numTets());
   EXPECT_NEAR(totalVolume(r->mesh), totalVolume(*mesh), 2e-4 * totalVolume(*mesh));
 }
+
+// Pass 46 of the default scene (`hysim run scenes/default.yaml --dump-cuts DIR` on the
+// flap-quality branch, state hash c4a72ef63ff0275d): three poor tets (q* 0.021) sit at a node
+// that lies on the sweep (within its tolerance) but that the cut neither created nor moved,
+// so it was no seed and the flap was never looked at. Nodes on the cut are seeds of the flap
+// search too.
+TEST(ShaveQuality, FlapsAtNodesOnTheSweepTheCutDidNotTouchArePeeled) {
+  const std::string dir = std::string(HYSIM_TEST_DATA_DIR) + "/cutting/";
+  auto mesh = readTetMesh(dir + "shave_pass46_mesh.msh");
+  ASSERT_TRUE(mesh.ok()) << mesh.error();
+  auto tris = readTriMesh(dir + "shave_pass46_surface.msh");
+  ASSERT_TRUE(tris.ok()) << tris.error();
+  auto surface = CutSurface::triangles(tris->X, tris->F);
+  ASSERT_TRUE(surface.ok()) << surface.error();
+  const double q0 = 0.1062;  // assets/uterus_myoma.msh
+  auto r = cut3d(*mesh, *surface, Cut3DOptions{});
+  ASSERT_TRUE(r.ok()) << r.error();
+  const Status v = validate(r->mesh);
+  ASSERT_TRUE(v.ok()) << v.error();
+  const double q = computeStats(withoutChips(r->mesh)).q_min;
+  std::printf("pass 46: q*_min %.4f (%.2fx the initial), %d tets in flaps\n", q, q / q0, r->report.flap_peeled);
+  EXPECT_GE(q, 0.25 * q0);
+  EXPECT_LE(r->mesh.numTets(), 1.2 * mesh->numTets());
+  EXPECT_NEAR(totalVolume(r->mesh), totalVolume(*mesh), 2e-4 * totalVolume(*mesh));
+}
 }  // namespace
 }  // namespace hysim::cutting
