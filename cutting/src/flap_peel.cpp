@@ -22,9 +22,10 @@
 //    its tets. A node whose remaining star falls apart into pieces is repaired by removing
 //    every piece but the largest (by volume) too, if the volume limits allow (at most
 //    flap_max_tets tets in the group). A node whose star was already not a manifold one
-//    before (earlier cuts pinched it) is accepted as long as it stays so (no worse); a node
-//    where the flap would open a hole through the surface (one piece, two boundary loops)
-//    keeps the flap's tets at it, unless the worst tet is among them;
+//    before (earlier cuts pinched it) is accepted as long as it stays so (no worse); at a
+//    node where the flap would open a hole through the surface (one piece, two boundary
+//    loops) the hole is opened to the boundary along the shortest chain of tets around the
+//    node (at most 4), or else the flap keeps its tets there unless the worst tet is among them;
 //  - the group is no bridge between two large parts: the tets next to it stay connected
 //    (walks of at most 256 tets); a closed piece that hung on the group only (a chip the
 //    sweep almost cut off, held by a neck this thin) is freed, as the cut frees chips.
@@ -249,6 +250,68 @@ void peelFlaps(const TetMesh& mesh, const CutRegion& region, const std::vector<s
   };
 
   std::vector<std::int32_t> group, groupNodes, rim, restored;
+  double vol = 0;  // of the group
+  auto inGroup = [&](int t) { return std::find(group.begin(), group.end(), t) != group.end(); };
+  // The tet across face f of t among the live tets and the group's, or -1.
+  auto acrossWithGroup = [&](int t, int f) {
+    const int a = mesh.T(t, kFace[f][0]), b = mesh.T(t, kFace[f][1]), c = mesh.T(t, kFace[f][2]);
+    for (int s = off[a]; s < off[a + 1]; ++s) {
+      const int u = star[s];
+      if (u != t && (!gone[u] || inGroup(u)) && has(u, b) && has(u, c)) return u;
+    }
+    return -1;
+  };
+  // v's live star is in `around`; the group's tets at v leave a hole in the boundary around
+  // v. Removes the shortest chain of tets around v (face to face through faces at v) from a
+  // tet at the hole to one on the outer boundary, adding it to the group; false if none of
+  // at most kChain tets.
+  constexpr int kChain = 4;
+  std::vector<int> chainFrom, chainDepth;
+  auto openHoleToBoundary = [&](int v) {
+    const int S = static_cast<int>(around.size());
+    chainFrom.assign(S, -2);
+    chainDepth.assign(S, 0);
+    std::vector<int> queue;
+    auto index = [&](int t) {
+      return static_cast<int>(std::find(around.begin(), around.end(), t) - around.begin());
+    };
+    for (int i = 0; i < S; ++i)
+      for (int f = 0; f < 4; ++f)
+        if (mesh.T(around[i], f) != v) {
+          const int u = acrossWithGroup(around[i], f);
+          if (u >= 0 && gone[u] && chainFrom[i] == -2) {
+            chainFrom[i] = -1;
+            chainDepth[i] = 1;
+            queue.push_back(i);
+          }
+        }
+    for (size_t h = 0; h < queue.size(); ++h) {
+      const int i = queue[h];
+      bool outer = false;
+      for (int f = 0; f < 4 && !outer; ++f)
+        if (mesh.T(around[i], f) != v) outer = acrossWithGroup(around[i], f) < 0;
+      if (outer) {
+        for (int j = i; j >= 0; j = chainFrom[j]) {
+          group.push_back(around[j]);
+          vol += volume(around[j]);
+          gone[around[j]] = 1;
+        }
+        return true;
+      }
+      if (chainDepth[i] >= kChain) continue;
+      for (int f = 0; f < 4; ++f)
+        if (mesh.T(around[i], f) != v) {
+          const int u = across(around[i], f);
+          const int j = u >= 0 ? index(u) : S;
+          if (j < S && chainFrom[j] == -2) {
+            chainFrom[j] = i;
+            chainDepth[j] = chainDepth[i] + 1;
+            queue.push_back(j);
+          }
+        }
+    }
+    return false;
+  };
   std::vector<double> pieceVolume;
   std::vector<std::int32_t> fanTets, walked, allWalked;
   std::vector<int> mark;  // #T walk marks, allocated when first needed
@@ -261,7 +324,7 @@ void peelFlaps(const TetMesh& mesh, const CutRegion& region, const std::vector<s
       if (findRoot(parent, static_cast<int>(i)) == root && !gone[cands[i]]) group.push_back(cands[i]);
     if (group.empty()) continue;
     bool onBoundary = false;
-    double vol = 0;
+    vol = 0;
     for (int t : group) {
       vol += volume(t);
       for (int f = 0; f < 4 && !onBoundary; ++f) onBoundary = across(t, f) < 0;
@@ -333,8 +396,16 @@ void peelFlaps(const TetMesh& mesh, const CutRegion& region, const std::vector<s
           for (int t : restored) gone[t] = 1;
           if (before == -1) continue;
           // The flap would open a hole through the surface around v (its star keeps one
-          // piece, but the boundary around v becomes two loops): keep the flap's tets at v
-          // where the worst tet is not among them and the rest is still a flap.
+          // piece, but the boundary around v becomes two loops): open the hole to the
+          // boundary along the shortest chain of tets around v (at most kChain), so the
+          // boundary around v is one loop again ...
+          liveStar(v);
+          if (openHoleToBoundary(v)) {
+            grew = true;
+            continue;
+          }
+          // ... or keep the flap's tets at v where the worst tet is not among them and the
+          // rest is still a flap.
           bool worstKept = false;
           for (int t : restored) worstKept = worstKept || t == worstTet;
           if (worstKept || restored.size() == group.size()) {

@@ -193,5 +193,31 @@ TEST(ShaveQuality, FlapsAtNodesOnTheSweepTheCutDidNotTouchArePeeled) {
   EXPECT_LE(r->mesh.numTets(), 1.2 * mesh->numTets());
   EXPECT_NEAR(totalVolume(r->mesh), totalVolume(*mesh), 2e-4 * totalVolume(*mesh));
 }
+
+// Pass 41 of the default scene on the flap-quality branch (`hysim run scenes/default.yaml
+// --dump-cuts DIR`, state hash c4a72ef63ff0275d): removing the poor flap (q* 0.005) would
+// open a hole through the surface around a boundary node next to it (the node's star stays
+// one piece, but its boundary becomes two loops). The hole is opened to the boundary along
+// the shortest chain of tets around the node, which removes the flap's last poor tet (q*
+// 0.0165) as well; before, the tets at that node were kept and the pass left 0.0165.
+TEST(ShaveQuality, AFlapThatWouldOpenAHoleAtANodeIsPeeledWithAChainToTheBoundary) {
+  const std::string dir = std::string(HYSIM_TEST_DATA_DIR) + "/cutting/";
+  auto mesh = readTetMesh(dir + "shave_pass41b_mesh.msh");
+  ASSERT_TRUE(mesh.ok()) << mesh.error();
+  auto tris = readTriMesh(dir + "shave_pass41b_surface.msh");
+  ASSERT_TRUE(tris.ok()) << tris.error();
+  auto surface = CutSurface::triangles(tris->X, tris->F);
+  ASSERT_TRUE(surface.ok()) << surface.error();
+  const double q0 = 0.1062;  // assets/uterus_myoma.msh
+  auto r = cut3d(*mesh, *surface, Cut3DOptions{});
+  ASSERT_TRUE(r.ok()) << r.error();
+  const Status v = validate(r->mesh);
+  ASSERT_TRUE(v.ok()) << v.error();
+  const double q = computeStats(withoutChips(r->mesh)).q_min;
+  std::printf("pass 41b: q*_min %.4f (%.2fx the initial), %d tets in flaps\n", q, q / q0, r->report.flap_peeled);
+  EXPECT_GE(q, 0.25 * q0);
+  EXPECT_LE(r->mesh.numTets(), 1.2 * mesh->numTets());
+  EXPECT_NEAR(totalVolume(r->mesh), totalVolume(*mesh), 2e-4 * totalVolume(*mesh));
+}
 }  // namespace
 }  // namespace hysim::cutting
