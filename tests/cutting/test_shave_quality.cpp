@@ -219,5 +219,37 @@ TEST(ShaveQuality, AFlapThatWouldOpenAHoleAtANodeIsPeeledWithAChainToTheBoundary
   EXPECT_LE(r->mesh.numTets(), 1.2 * mesh->numTets());
   EXPECT_NEAR(totalVolume(r->mesh), totalVolume(*mesh), 2e-4 * totalVolume(*mesh));
 }
+
+// Pass 47 of the default scene on the flap-quality branch (`hysim run scenes/default.yaml
+// --dump-cuts DIR`, state hash 771ff1045f7ccff9): a flat tet (q* 0.0188, 0.17 regular tets
+// of the local edge) whose removal pinches a node; the repair takes the smaller piece of that
+// node's star with it (2.7 regular tets in all), within the default group limit (3.0).
+TEST(ShaveQuality, AFlatTetWhoseRepairTakesAPinchedPieceIsPeeledWithinTheGroupLimit) {
+  const std::string dir = std::string(HYSIM_TEST_DATA_DIR) + "/cutting/";
+  auto mesh = readTetMesh(dir + "shave_pass47_mesh.msh");
+  ASSERT_TRUE(mesh.ok()) << mesh.error();
+  auto tris = readTriMesh(dir + "shave_pass47_surface.msh");
+  ASSERT_TRUE(tris.ok()) << tris.error();
+  auto surface = CutSurface::triangles(tris->X, tris->F);
+  ASSERT_TRUE(surface.ok()) << surface.error();
+  const double q0 = 0.1062;  // assets/uterus_myoma.msh
+  auto r = cut3d(*mesh, *surface, Cut3DOptions{});
+  ASSERT_TRUE(r.ok()) << r.error();
+  const Status v = validate(r->mesh);
+  ASSERT_TRUE(v.ok()) << v.error();
+  const double q = computeStats(withoutChips(r->mesh)).q_min;
+  std::printf("pass 47: q*_min %.4f (%.2fx the initial), %d tets in flaps\n", q, q / q0, r->report.flap_peeled);
+  EXPECT_GE(q, 0.25 * q0);
+  EXPECT_LE(r->mesh.numTets(), 1.2 * mesh->numTets());
+  EXPECT_NEAR(totalVolume(r->mesh), totalVolume(*mesh), 2e-4 * totalVolume(*mesh));
+  // With the earlier limits (1.5 per group, 3.0 per pass) the flat tet stays.
+  Cut3DOptions tight;
+  tight.optimize.flap_group_volume = 1.5;
+  tight.optimize.flap_pass_volume = 3.0;
+  auto t = cut3d(*mesh, *surface, tight);
+  ASSERT_TRUE(t.ok()) << t.error();
+  EXPECT_TRUE(validate(t->mesh).ok());
+  EXPECT_LT(computeStats(withoutChips(t->mesh)).q_min, 0.25 * q0);
+}
 }  // namespace
 }  // namespace hysim::cutting
