@@ -113,12 +113,13 @@ struct Optimize3DOptions {
   // wedges the sweep leaves against an earlier cut or the boundary (a fan of flat tets around
   // a node a few hundredths of a millimetre off the cut, knife edges) that no move, collapse
   // or single-tet peel can repair; the loop vaporises such tissue. 0 disables.
-  // The group limit covers a flat tet whose repair takes the smaller piece of a pinched star
-  // with it (pass 47 of the default scene: 0.17 -> 2.7 regular tets).
+  // The group limit covers a flat tet whose repair takes the smaller pieces of a pinched
+  // star with it (default scene: 0.17 -> 2.7, 0.7 -> 3.2 and 0.4 -> 6.4 regular tets at the
+  // myoma's base).
   double flap_quality = 0.03;
   int flap_rings = 1;
-  double flap_group_volume = 3.0;
-  double flap_pass_volume = 4.5;
+  double flap_group_volume = 7.0;
+  double flap_pass_volume = 8.0;
   int flap_max_tets = 24;
 };
 
