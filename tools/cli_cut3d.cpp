@@ -107,6 +107,9 @@ int runCut3d(const Cut3dArgs& a) {
     auto j = statsJson(s);
     j["time_ms"] = ms;
     j["optimize_ms"] = r.optimize_ms;
+    j["peeled_elements"] = r.peeled_elements;
+    j["flap_peeled"] = r.flap_peeled;
+    j["peeled_volume"] = r.peeled_volume;
     j["method"] = cutting::cutMethodName(o.method);
     j["components"] = comps.count;
     nlohmann::ordered_json vols = nlohmann::ordered_json::array();

@@ -1172,6 +1172,7 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
     optimizeAroundCut(out, region, options.optimize, &moved, &peeled, &counts);
     report.optimize_iterations = counts.iterations;
     report.peeled_elements = counts.peeled;
+    report.flap_peeled = counts.flap_peeled;
     report.collapsed_edges = counts.collapsed;
     report.late_snaps = counts.late_snaps;
     cutNodes.insert(cutNodes.end(), counts.onto_cut.begin(), counts.onto_cut.end());

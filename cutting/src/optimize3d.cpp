@@ -36,6 +36,7 @@
 
 #include "hysim/cutting/cut3d.hpp"
 #include "hysim/cutting/mesh_stats.hpp"
+#include "flap_peel.hpp"
 #include "optimize3d_internal.hpp"
 
 namespace hysim::cutting {
@@ -1420,6 +1421,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       if (didMove[n]) moved->push_back(n);
   if (moved) moved->insert(moved->end(), lateSnapped.begin(), lateSnapped.end());
   if (counts) counts->onto_cut = lateSnapped;
+  if (curved) peelFlaps(mesh, region, seeds, options, dead, counts);  // flap_peel.cpp
 }
 
 }  // namespace hysim::cutting

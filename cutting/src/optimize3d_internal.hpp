@@ -23,6 +23,7 @@ struct OptimizeCounts {
   int collapsed = 0;
   int late_snaps = 0;
   int flips = 0;
+  int flap_peeled = 0;  // of peeled: in flaps (flap_peel.cpp)
   std::vector<std::int32_t> onto_cut;  // the nodes late snapping moved onto the cut
   double peeled_volume = 0;
 };

@@ -105,5 +105,151 @@ TEST(ShaveQuality, DumpedPassOverRoughBoundariesKeepsAQuarterOfTheInitialQuality
   EXPECT_LT(computeStats(o->mesh).q_min, 0.25 * q0);
 }
 
+// Pass 41 of the default scene (rest mesh before the pass and its sweep, from
+// `hysim run scenes/default.yaml --dump-cuts DIR` on main, state hash 8ae57a91dd3daf84): the sweep passes
+// 0.05 mm from a boundary node and leaves a fan of flat tets (two boundary faces each: one in
+// the cut, one on the outer boundary) between the cut and that node, plus a thin neck holding
+// a chip. No single-tet peel, collapse or move repairs them (each peel alone leaves a pinched
+// edge); before flap peeling (flap_peel.cpp) the kept tissue's q*_min was 0.0044 (0.04x).
+TEST(ShaveQuality, ThinFlapsBetweenTheSweepAndTheBoundaryArePeeledAsAGroup) {
+  const std::string dir = std::string(HYSIM_TEST_DATA_DIR) + "/cutting/";
+  auto mesh = readTetMesh(dir + "shave_pass41_mesh.msh");
+  ASSERT_TRUE(mesh.ok()) << mesh.error();
+  auto tris = readTriMesh(dir + "shave_pass41_surface.msh");
+  ASSERT_TRUE(tris.ok()) << tris.error();
+  auto surface = CutSurface::triangles(tris->X, tris->F);
+  ASSERT_TRUE(surface.ok()) << surface.error();
+  const double q0 = 0.1062;  // assets/uterus_myoma.msh
+  auto r = cut3d(*mesh, *surface, Cut3DOptions{});
+  ASSERT_TRUE(r.ok()) << r.error();
+  const Status v = validate(r->mesh);
+  ASSERT_TRUE(v.ok()) << v.error();
+  EXPECT_GT(r->report.flap_peeled, 0);
+  const TetMesh kept = withoutChips(r->mesh);
+  const double q = computeStats(kept).q_min;
+  std::printf("pass 41: q*_min %.4f (%.2fx the initial), %d tets in flaps\n", q, q / q0, r->report.flap_peeled);
+  EXPECT_GE(q, 0.25 * q0);
+  EXPECT_LE(r->mesh.numTets(), 1.2 * mesh->numTets());
+  // Flaps are thin: the volume lost (peeling, chips included) stays small.
+  EXPECT_NEAR(totalVolume(r->mesh), totalVolume(*mesh), 2e-4 * totalVolume(*mesh));
+  // Without flap peeling the mesh is valid but the flap stays.
+  Cut3DOptions off;
+  off.optimize.flap_quality = 0;
+  auto o = cut3d(*mesh, *surface, off);
+  ASSERT_TRUE(o.ok()) << o.error();
+  EXPECT_TRUE(validate(o->mesh).ok());
+  EXPECT_EQ(o->report.flap_peeled, 0);
+  EXPECT_LT(computeStats(withoutChips(o->mesh)).q_min, 0.25 * q0);
+}
+
+
+// Pass 45 of the default scene (from `hysim run scenes/default.yaml --dump-cuts DIR` on the
+// flap-quality branch, state hash 9545b076d460d431): the poor flap (q* 0.0021) touches a
+// boundary node whose star earlier cuts had already left pinched (not a manifold star before
+// the flap is removed). Removing the flap does not make that node worse, so it is peeled;
+// before, such a flap was refused and the pass left q*_min 0.0021 (0.02x).
+TEST(ShaveQuality, FlapsAtANodeAlreadyPinchedBeforeThePassArePeeled) {
+  const std::string dir = std::string(HYSIM_TEST_DATA_DIR) + "/cutting/";
+  auto mesh = readTetMesh(dir + "shave_pass45_mesh.msh");
+  ASSERT_TRUE(mesh.ok()) << mesh.error();
+  auto tris = readTriMesh(dir + "shave_pass45_surface.msh");
+  ASSERT_TRUE(tris.ok()) << tris.error();
+  auto surface = CutSurface::triangles(tris->X, tris->F);
+  ASSERT_TRUE(surface.ok()) << surface.error();
+  const double q0 = 0.1062;  // assets/uterus_myoma.msh
+  auto r = cut3d(*mesh, *surface, Cut3DOptions{});
+  ASSERT_TRUE(r.ok()) << r.error();
+  const Status v = validate(r->mesh);
+  ASSERT_TRUE(v.ok()) << v.error();
+  EXPECT_GT(r->report.flap_peeled, 0);
+  const double q = computeStats(withoutChips(r->mesh)).q_min;
+  std::printf("pass 45: q*_min %.4f (%.2fx the initial), %d tets in flaps\n", q, q / q0, r->report.flap_peeled);
+  EXPECT_GE(q, 0.25 * q0);
+  EXPECT_LE(r->mesh.numTets(), 1.2 * mesh->numTets());
+  EXPECT_NEAR(totalVolume(r->mesh), totalVolume(*mesh), 2e-4 * totalVolume(*mesh));
+}
+
+// Pass 46 of the default scene (`hysim run scenes/default.yaml --dump-cuts DIR` on the
+// flap-quality branch, state hash c4a72ef63ff0275d): three poor tets (q* 0.021) sit at a node
+// that lies on the sweep (within its tolerance) but that the cut neither created nor moved,
+// so it was no seed and the flap was never looked at. Nodes on the cut are seeds of the flap
+// search too.
+TEST(ShaveQuality, FlapsAtNodesOnTheSweepTheCutDidNotTouchArePeeled) {
+  const std::string dir = std::string(HYSIM_TEST_DATA_DIR) + "/cutting/";
+  auto mesh = readTetMesh(dir + "shave_pass46_mesh.msh");
+  ASSERT_TRUE(mesh.ok()) << mesh.error();
+  auto tris = readTriMesh(dir + "shave_pass46_surface.msh");
+  ASSERT_TRUE(tris.ok()) << tris.error();
+  auto surface = CutSurface::triangles(tris->X, tris->F);
+  ASSERT_TRUE(surface.ok()) << surface.error();
+  const double q0 = 0.1062;  // assets/uterus_myoma.msh
+  auto r = cut3d(*mesh, *surface, Cut3DOptions{});
+  ASSERT_TRUE(r.ok()) << r.error();
+  const Status v = validate(r->mesh);
+  ASSERT_TRUE(v.ok()) << v.error();
+  const double q = computeStats(withoutChips(r->mesh)).q_min;
+  std::printf("pass 46: q*_min %.4f (%.2fx the initial), %d tets in flaps\n", q, q / q0, r->report.flap_peeled);
+  EXPECT_GE(q, 0.25 * q0);
+  EXPECT_LE(r->mesh.numTets(), 1.2 * mesh->numTets());
+  EXPECT_NEAR(totalVolume(r->mesh), totalVolume(*mesh), 2e-4 * totalVolume(*mesh));
+}
+
+// Pass 41 of the default scene on the flap-quality branch (`hysim run scenes/default.yaml
+// --dump-cuts DIR`, state hash c4a72ef63ff0275d): removing the poor flap (q* 0.005) would
+// open a hole through the surface around a boundary node next to it (the node's star stays
+// one piece, but its boundary becomes two loops). The hole is opened to the boundary along
+// the shortest chain of tets around the node, which removes the flap's last poor tet (q*
+// 0.0165) as well; before, the tets at that node were kept and the pass left 0.0165.
+TEST(ShaveQuality, AFlapThatWouldOpenAHoleAtANodeIsPeeledWithAChainToTheBoundary) {
+  const std::string dir = std::string(HYSIM_TEST_DATA_DIR) + "/cutting/";
+  auto mesh = readTetMesh(dir + "shave_pass41b_mesh.msh");
+  ASSERT_TRUE(mesh.ok()) << mesh.error();
+  auto tris = readTriMesh(dir + "shave_pass41b_surface.msh");
+  ASSERT_TRUE(tris.ok()) << tris.error();
+  auto surface = CutSurface::triangles(tris->X, tris->F);
+  ASSERT_TRUE(surface.ok()) << surface.error();
+  const double q0 = 0.1062;  // assets/uterus_myoma.msh
+  auto r = cut3d(*mesh, *surface, Cut3DOptions{});
+  ASSERT_TRUE(r.ok()) << r.error();
+  const Status v = validate(r->mesh);
+  ASSERT_TRUE(v.ok()) << v.error();
+  const double q = computeStats(withoutChips(r->mesh)).q_min;
+  std::printf("pass 41b: q*_min %.4f (%.2fx the initial), %d tets in flaps\n", q, q / q0, r->report.flap_peeled);
+  EXPECT_GE(q, 0.25 * q0);
+  EXPECT_LE(r->mesh.numTets(), 1.2 * mesh->numTets());
+  EXPECT_NEAR(totalVolume(r->mesh), totalVolume(*mesh), 2e-4 * totalVolume(*mesh));
+}
+
+// Pass 47 of the default scene on the flap-quality branch (`hysim run scenes/default.yaml
+// --dump-cuts DIR`, state hash 771ff1045f7ccff9): a flat tet (q* 0.0188, 0.17 regular tets
+// of the local edge) whose removal pinches a node; the repair takes the smaller piece of that
+// node's star with it (2.7 regular tets in all), within the default group limit (3.0).
+TEST(ShaveQuality, AFlatTetWhoseRepairTakesAPinchedPieceIsPeeledWithinTheGroupLimit) {
+  const std::string dir = std::string(HYSIM_TEST_DATA_DIR) + "/cutting/";
+  auto mesh = readTetMesh(dir + "shave_pass47_mesh.msh");
+  ASSERT_TRUE(mesh.ok()) << mesh.error();
+  auto tris = readTriMesh(dir + "shave_pass47_surface.msh");
+  ASSERT_TRUE(tris.ok()) << tris.error();
+  auto surface = CutSurface::triangles(tris->X, tris->F);
+  ASSERT_TRUE(surface.ok()) << surface.error();
+  const double q0 = 0.1062;  // assets/uterus_myoma.msh
+  auto r = cut3d(*mesh, *surface, Cut3DOptions{});
+  ASSERT_TRUE(r.ok()) << r.error();
+  const Status v = validate(r->mesh);
+  ASSERT_TRUE(v.ok()) << v.error();
+  const double q = computeStats(withoutChips(r->mesh)).q_min;
+  std::printf("pass 47: q*_min %.4f (%.2fx the initial), %d tets in flaps\n", q, q / q0, r->report.flap_peeled);
+  EXPECT_GE(q, 0.25 * q0);
+  EXPECT_LE(r->mesh.numTets(), 1.2 * mesh->numTets());
+  EXPECT_NEAR(totalVolume(r->mesh), totalVolume(*mesh), 2e-4 * totalVolume(*mesh));
+  // With the earlier limits (1.5 per group, 3.0 per pass) the flat tet stays.
+  Cut3DOptions tight;
+  tight.optimize.flap_group_volume = 1.5;
+  tight.optimize.flap_pass_volume = 3.0;
+  auto t = cut3d(*mesh, *surface, tight);
+  ASSERT_TRUE(t.ok()) << t.error();
+  EXPECT_TRUE(validate(t->mesh).ok());
+  EXPECT_LT(computeStats(withoutChips(t->mesh)).q_min, 0.25 * q0);
+}
 }  // namespace
 }  // namespace hysim::cutting

@@ -104,6 +104,23 @@ struct Optimize3DOptions {
   // (collapses and moves add and remove volume locally); the sum of the absolute changes
   // may reach this x the budget. Plane cuts: the sum of the absolute changes (as 1).
   double volume_churn_factor = 4.0;
+  // Curved cuts, last: flaps (flap_peel.cpp). Tets below this q* with a node within
+  // flap_rings edge steps of what the cut touched, connected through faces, are removed
+  // together where the group touches the boundary, its volume is at most flap_group_volume x
+  // a regular tet of the cut's local edge (all groups of one cut: flap_pass_volume x that),
+  // the mesh stays manifold (a node whose star falls apart also loses its smaller pieces, up
+  // to flap_max_tets tets in the group) and the group is no bridge between large parts. Thin
+  // wedges the sweep leaves against an earlier cut or the boundary (a fan of flat tets around
+  // a node a few hundredths of a millimetre off the cut, knife edges) that no move, collapse
+  // or single-tet peel can repair; the loop vaporises such tissue. 0 disables.
+  // The group limit covers a flat tet whose repair takes the smaller pieces of a pinched
+  // star with it (default scene: 0.17 -> 2.7, 0.7 -> 3.2 and 0.4 -> 6.4 regular tets at the
+  // myoma's base).
+  double flap_quality = 0.03;
+  int flap_rings = 1;
+  double flap_group_volume = 7.0;
+  double flap_pass_volume = 8.0;
+  int flap_max_tets = 24;
 };
 
 struct Cut3DOptions {
@@ -172,6 +189,7 @@ struct Cut3DReport {
   int late_snaps = 0;         // nodes near the cut the optimisation moved onto it
   int peeled_elements = 0;    // slivers removed by the optimisation
   double peeled_volume = 0;   // their volume
+  int flap_peeled = 0;        // of the peeled elements, those removed in flaps (flap_quality)
   int optimize_iterations = 0;
   double cut_ms = 0, optimize_ms = 0;
 };

@@ -1,0 +1,496 @@
+// Flap peeling after a curved cut (shaving): thin pieces of tissue near the cut whose tets
+// are all poor (q* below flap_quality) and that touch the boundary are removed as a group.
+//
+// Why: a shaving sweep that meets an earlier cut surface, or the outer boundary, at a shallow
+// angle leaves a wedge of tissue between the two surfaces that is much thinner than the local
+// edge length: a fan of flat tets around a boundary node lying a few hundredths of a
+// millimetre off the cut, or a knife edge (tets with two boundary faces meeting at a small
+// dihedral angle). Their nodes are all held (on the cut, on the rim, on boundary features),
+// and removing one tet at a time leaves a non-manifold node (the flap's tets hang together
+// around it), so the single-tet peeling of optimize3d.cpp refuses each of them. Removing the
+// whole flap keeps the mesh manifold, and it is what the loop electrode does physically:
+// tissue this thin between the loop and the surface is vaporised.
+//
+// Rule: candidates are the live tets with q* below flap_quality that have a node within
+// flap_rings edge steps of the seeds (what the cut touched, and every node on the cut).
+// Candidates sharing faces form
+// groups; a group with at least one boundary face is removed when
+//  - its volume is at most flap_group_volume x a regular tet with the cut's local edge, and
+//    all removed flaps of this cut together at most flap_pass_volume x that;
+//  - every node of the group keeps a manifold star (its remaining tets connected through
+//    faces, every face at most twice, the boundary around it one closed loop) or loses all
+//    its tets. A node whose remaining star falls apart into pieces is repaired by removing
+//    every piece but the largest (by volume) too, if the volume limits allow (at most
+//    flap_max_tets tets in the group). A node whose star was already not a manifold one
+//    before (earlier cuts pinched it) is accepted as long as it stays so (no worse); at a
+//    node where the flap would open a hole through the surface (one piece, two boundary
+//    loops) the hole is opened to the boundary along the shortest chain of tets around the
+//    node (at most 4), or else the flap keeps its tets there unless the worst tet is among them;
+//  - the group is no bridge between two large parts: the tets next to it stay connected
+//    (walks of at most 256 tets); a closed piece that hung on the group only (a chip the
+//    sweep almost cut off, held by a neck this thin) is freed, as the cut frees chips.
+// Local: one O(#T) node -> tet pass; the rest touches only the tets around the seeds.
+#include "flap_peel.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <numeric>
+#include <vector>
+
+#include "hysim/cutting/mesh_stats.hpp"
+
+namespace hysim::cutting {
+namespace {
+
+using Vec3 = Eigen::Vector3d;
+constexpr int kFace[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
+
+int findRoot(std::vector<int>& parent, int a) {
+  while (parent[a] != a) {
+    parent[a] = parent[parent[a]];
+    a = parent[a];
+  }
+  return a;
+}
+
+}  // namespace
+
+void peelFlaps(const TetMesh& mesh, const CutRegion& region, const std::vector<std::int32_t>& seeds,
+               const Optimize3DOptions& options, std::vector<std::uint8_t>* dead, OptimizeCounts* counts) {
+  const int N = mesh.numNodes(), M = mesh.numTets();
+  if (!(options.flap_quality > 0) || seeds.empty() || N == 0 || !(region.edge_length > 0)) return;
+  const double edgeTet = region.edge_length * region.edge_length * region.edge_length / (6.0 * std::sqrt(2.0));
+  const double groupLimit = options.flap_group_volume * edgeTet;
+  double passLeft = options.flap_pass_volume * edgeTet;
+  if (!(groupLimit > 0) || !(passLeft > 0)) return;
+  std::vector<std::uint8_t>& gone = *dead;
+
+  // Node -> live tets (CSR, one pass over the tets).
+  std::vector<std::int32_t> off(N + 1, 0), star;
+  for (int t = 0; t < M; ++t)
+    if (!gone[t])
+      for (int k = 0; k < 4; ++k) ++off[mesh.T(t, k) + 1];
+  for (int i = 0; i < N; ++i) off[i + 1] += off[i];
+  star.resize(off[N]);
+  {
+    std::vector<std::int32_t> fill(off.begin(), off.end() - 1);
+    for (int t = 0; t < M; ++t)
+      if (!gone[t])
+        for (int k = 0; k < 4; ++k) star[fill[mesh.T(t, k)]++] = t;
+  }
+  auto pos = [&](int n) { return Vec3(mesh.X.row(n).transpose()); };
+  auto volume = [&](int t) {
+    const Vec3 a = pos(mesh.T(t, 0));
+    return (pos(mesh.T(t, 1)) - a).dot((pos(mesh.T(t, 2)) - a).cross(pos(mesh.T(t, 3)) - a)) / 6.0;
+  };
+  auto has = [&](int t, int n) {
+    return mesh.T(t, 0) == n || mesh.T(t, 1) == n || mesh.T(t, 2) == n || mesh.T(t, 3) == n;
+  };
+  // The live tet other than t across face f of t, or -1 (a boundary face).
+  auto across = [&](int t, int f) {
+    const int a = mesh.T(t, kFace[f][0]), b = mesh.T(t, kFace[f][1]), c = mesh.T(t, kFace[f][2]);
+    for (int s = off[a]; s < off[a + 1]; ++s) {
+      const int u = star[s];
+      if (u != t && !gone[u] && has(u, b) && has(u, c)) return u;
+    }
+    return -1;
+  };
+
+  // Nodes within flap_rings edge steps of the seeds.
+  std::vector<std::int8_t> ring(N, -1);
+  std::vector<std::int32_t> frontier, next, nearNodes;
+  for (int n : seeds)
+    if (n >= 0 && n < N && ring[n] < 0) {
+      ring[n] = 0;
+      frontier.push_back(n);
+      nearNodes.push_back(n);
+    }
+  // Nodes on the cut that the cut did not touch (it passed within eps of them) are seeds too.
+  for (int n = 0; n < N && n < static_cast<int>(region.on_cut.size()); ++n)
+    if (region.on_cut[n] && ring[n] < 0 && off[n + 1] > off[n]) {
+      ring[n] = 0;
+      frontier.push_back(n);
+      nearNodes.push_back(n);
+    }
+  for (int r = 1; r <= options.flap_rings && !frontier.empty(); ++r) {
+    next.clear();
+    for (int n : frontier)
+      for (int s = off[n]; s < off[n + 1]; ++s)
+        for (int k = 0; k < 4; ++k) {
+          const int v = mesh.T(star[s], k);
+          if (ring[v] < 0) {
+            ring[v] = static_cast<std::int8_t>(r);
+            next.push_back(v);
+            nearNodes.push_back(v);
+          }
+        }
+    frontier.swap(next);
+  }
+
+  // Candidates: poor live tets around the near nodes, each once.
+  std::vector<std::int32_t> cands;
+  std::vector<double> candQ;
+  for (int n : nearNodes)
+    for (int s = off[n]; s < off[n + 1]; ++s) cands.push_back(star[s]);
+  std::sort(cands.begin(), cands.end());
+  cands.erase(std::unique(cands.begin(), cands.end()), cands.end());
+  {
+    size_t kept = 0;
+    for (int t : cands) {
+      const double q = radiusRatio(pos(mesh.T(t, 0)), pos(mesh.T(t, 1)), pos(mesh.T(t, 2)), pos(mesh.T(t, 3)));
+      if (q < options.flap_quality) {
+        cands[kept++] = t;
+        candQ.push_back(q);
+      }
+    }
+    cands.resize(kept);
+  }
+  if (cands.empty()) return;
+  auto candIndex = [&](int t) {
+    const auto it = std::lower_bound(cands.begin(), cands.end(), t);
+    return it != cands.end() && *it == t ? static_cast<int>(it - cands.begin()) : -1;
+  };
+  // Groups: candidates connected through shared faces; the worst first.
+  std::vector<int> parent(cands.size());
+  std::iota(parent.begin(), parent.end(), 0);
+  for (size_t i = 0; i < cands.size(); ++i)
+    for (int f = 0; f < 4; ++f) {
+      const int u = across(cands[i], f);
+      const int j = u >= 0 ? candIndex(u) : -1;
+      if (j >= 0) parent[findRoot(parent, static_cast<int>(i))] = findRoot(parent, j);
+    }
+  std::vector<std::pair<double, int>> order;  // (worst q* of the group, root)
+  {
+    std::vector<double> worst(cands.size(), 1.0);
+    for (size_t i = 0; i < cands.size(); ++i) {
+      const int r = findRoot(parent, static_cast<int>(i));
+      worst[r] = std::min(worst[r], candQ[i]);
+    }
+    for (size_t i = 0; i < cands.size(); ++i)
+      if (findRoot(parent, static_cast<int>(i)) == static_cast<int>(i)) order.emplace_back(worst[i], static_cast<int>(i));
+    std::sort(order.begin(), order.end());
+  }
+
+  // The live tets around v.
+  std::vector<std::int32_t> around;
+  auto liveStar = [&](int v) {
+    around.clear();
+    for (int s = off[v]; s < off[v + 1]; ++s)
+      if (!gone[star[s]]) around.push_back(star[s]);
+  };
+  // Pieces of v's live star (connected through faces with v) into pieceOf (index in
+  // `around`); returns the number of pieces, or -1 if a face is used more than twice or the
+  // boundary around v is not one closed loop per piece (a pinched edge).
+  std::vector<int> pieceOf, linkParent;
+  std::vector<std::array<std::int32_t, 3>> pairs;  // (a, b, index in around), a < b
+  std::vector<std::int32_t> linkNodes, pinched;
+  auto pieces = [&](int v) {
+    pinched.clear();
+    const int S = static_cast<int>(around.size());
+    pieceOf.assign(S, 0);
+    if (S == 0) return 0;
+    pairs.clear();
+    for (int i = 0; i < S; ++i) {
+      std::int32_t o[3], m = 0;
+      for (int k = 0; k < 4; ++k)
+        if (mesh.T(around[i], k) != v && m < 3) o[m++] = mesh.T(around[i], k);
+      std::sort(o, o + 3);
+      pairs.push_back({o[0], o[1], i});
+      pairs.push_back({o[0], o[2], i});
+      pairs.push_back({o[1], o[2], i});
+    }
+    std::sort(pairs.begin(), pairs.end());
+    std::vector<int>& p = pieceOf;
+    std::iota(p.begin(), p.end(), 0);
+    linkNodes.clear();
+    std::vector<std::array<std::int32_t, 2>> boundary;
+    for (size_t i = 0; i < pairs.size();) {
+      size_t j = i;
+      while (j < pairs.size() && pairs[j][0] == pairs[i][0] && pairs[j][1] == pairs[i][1]) ++j;
+      if (j - i > 2) return -1;
+      if (j - i == 2) {
+        p[findRoot(p, pairs[i][2])] = findRoot(p, pairs[i + 1][2]);
+      } else {
+        boundary.push_back({pairs[i][0], pairs[i][1]});
+        linkNodes.push_back(pairs[i][0]);
+        linkNodes.push_back(pairs[i][1]);
+      }
+      i = j;
+    }
+    int count = 0;
+    for (int i = 0; i < S; ++i)
+      if (findRoot(p, i) == i) ++count;
+    for (int i = 0; i < S; ++i) p[i] = findRoot(p, i);
+    // Boundary link: every node twice, as many closed loops as pieces (a piece without
+    // boundary is a closed ball around an interior node: only alone).
+    std::sort(linkNodes.begin(), linkNodes.end());
+    for (size_t i = 0; i < linkNodes.size();) {
+      size_t j = i;
+      while (j < linkNodes.size() && linkNodes[j] == linkNodes[i]) ++j;
+      if (j - i != 2) {
+        if ((j - i) % 2 != 0) return -1;
+        pinched.push_back(linkNodes[i]);  // edge (v, w) with two or more fans of tets
+      }
+      i = j;
+    }
+    if (!pinched.empty()) return -2;
+    linkNodes.erase(std::unique(linkNodes.begin(), linkNodes.end()), linkNodes.end());
+    linkParent.resize(linkNodes.size());
+    std::iota(linkParent.begin(), linkParent.end(), 0);
+    auto local = [&](int n) {
+      return static_cast<int>(std::lower_bound(linkNodes.begin(), linkNodes.end(), n) - linkNodes.begin());
+    };
+    for (const auto& e : boundary) linkParent[findRoot(linkParent, local(e[0]))] = findRoot(linkParent, local(e[1]));
+    int loops = 0;
+    for (size_t i = 0; i < linkNodes.size(); ++i)
+      if (findRoot(linkParent, static_cast<int>(i)) == static_cast<int>(i)) ++loops;
+    if (loops != count && !(count == 1 && loops == 0)) return -1;
+    return count;
+  };
+
+  std::vector<std::int32_t> group, groupNodes, rim, restored;
+  double vol = 0;  // of the group
+  auto inGroup = [&](int t) { return std::find(group.begin(), group.end(), t) != group.end(); };
+  // The tet across face f of t among the live tets and the group's, or -1.
+  auto acrossWithGroup = [&](int t, int f) {
+    const int a = mesh.T(t, kFace[f][0]), b = mesh.T(t, kFace[f][1]), c = mesh.T(t, kFace[f][2]);
+    for (int s = off[a]; s < off[a + 1]; ++s) {
+      const int u = star[s];
+      if (u != t && (!gone[u] || inGroup(u)) && has(u, b) && has(u, c)) return u;
+    }
+    return -1;
+  };
+  // v's live star is in `around`; the group's tets at v leave a hole in the boundary around
+  // v. Removes the shortest chain of tets around v (face to face through faces at v) from a
+  // tet at the hole to one on the outer boundary, adding it to the group; false if none of
+  // at most kChain tets.
+  constexpr int kChain = 4;
+  std::vector<int> chainFrom, chainDepth;
+  auto openHoleToBoundary = [&](int v) {
+    const int S = static_cast<int>(around.size());
+    chainFrom.assign(S, -2);
+    chainDepth.assign(S, 0);
+    std::vector<int> queue;
+    auto index = [&](int t) {
+      return static_cast<int>(std::find(around.begin(), around.end(), t) - around.begin());
+    };
+    for (int i = 0; i < S; ++i)
+      for (int f = 0; f < 4; ++f)
+        if (mesh.T(around[i], f) != v) {
+          const int u = acrossWithGroup(around[i], f);
+          if (u >= 0 && gone[u] && chainFrom[i] == -2) {
+            chainFrom[i] = -1;
+            chainDepth[i] = 1;
+            queue.push_back(i);
+          }
+        }
+    for (size_t h = 0; h < queue.size(); ++h) {
+      const int i = queue[h];
+      bool outer = false;
+      for (int f = 0; f < 4 && !outer; ++f)
+        if (mesh.T(around[i], f) != v) outer = acrossWithGroup(around[i], f) < 0;
+      if (outer) {
+        for (int j = i; j >= 0; j = chainFrom[j]) {
+          group.push_back(around[j]);
+          vol += volume(around[j]);
+          gone[around[j]] = 1;
+        }
+        return true;
+      }
+      if (chainDepth[i] >= kChain) continue;
+      for (int f = 0; f < 4; ++f)
+        if (mesh.T(around[i], f) != v) {
+          const int u = across(around[i], f);
+          const int j = u >= 0 ? index(u) : S;
+          if (j < S && chainFrom[j] == -2) {
+            chainFrom[j] = i;
+            chainDepth[j] = chainDepth[i] + 1;
+            queue.push_back(j);
+          }
+        }
+    }
+    return false;
+  };
+  std::vector<double> pieceVolume;
+  std::vector<std::int32_t> fanTets, walked, allWalked;
+  std::vector<int> mark;  // #T walk marks, allocated when first needed
+  std::vector<int> fanParent;
+  int peeled = 0;
+  double peeledVolume = 0;
+  for (const auto& [worstQ, root] : order) {
+    group.clear();
+    for (size_t i = 0; i < cands.size(); ++i)
+      if (findRoot(parent, static_cast<int>(i)) == root && !gone[cands[i]]) group.push_back(cands[i]);
+    if (group.empty()) continue;
+    bool onBoundary = false;
+    vol = 0;
+    for (int t : group) {
+      vol += volume(t);
+      for (int f = 0; f < 4 && !onBoundary; ++f) onBoundary = across(t, f) < 0;
+    }
+    if (!onBoundary || vol > groupLimit || vol > passLeft) continue;
+    int worstTet = group[0];
+    {
+      double wq = 2;
+      for (int t : group) {
+        const double q = radiusRatio(pos(mesh.T(t, 0)), pos(mesh.T(t, 1)), pos(mesh.T(t, 2)), pos(mesh.T(t, 3)));
+        if (q < wq) {
+          wq = q;
+          worstTet = t;
+        }
+      }
+    }
+    for (int t : group) gone[t] = 1;
+    // Check the stars of the group's nodes; repair pinched nodes by removing the smaller pieces.
+    bool ok = true;
+    for (int round = 0; ok; ++round) {
+      groupNodes.clear();
+      for (int t : group)
+        for (int k = 0; k < 4; ++k) groupNodes.push_back(mesh.T(t, k));
+      std::sort(groupNodes.begin(), groupNodes.end());
+      groupNodes.erase(std::unique(groupNodes.begin(), groupNodes.end()), groupNodes.end());
+      bool grew = false;
+      for (int v : groupNodes) {
+        liveStar(v);
+        const int count = pieces(v);
+        if (count == -2) {
+          // Pinched edges (v, w): keep the largest fan of tets around each, remove the others.
+          for (int w : pinched) {
+            fanTets.clear();
+            for (int t : around)
+              if (!gone[t] && has(t, w)) fanTets.push_back(t);
+            const int F = static_cast<int>(fanTets.size());
+            fanParent.resize(F);
+            std::iota(fanParent.begin(), fanParent.end(), 0);
+            for (int a = 0; a < F; ++a)
+              for (int b = a + 1; b < F; ++b) {
+                int shared = 0;
+                for (int k = 0; k < 4; ++k) shared += has(fanTets[b], mesh.T(fanTets[a], k));
+                if (shared == 3) fanParent[findRoot(fanParent, a)] = findRoot(fanParent, b);
+              }
+            pieceVolume.assign(F, 0.0);
+            for (int a = 0; a < F; ++a) pieceVolume[findRoot(fanParent, a)] += volume(fanTets[a]);
+            const int keep = static_cast<int>(std::max_element(pieceVolume.begin(), pieceVolume.end()) - pieceVolume.begin());
+            for (int a = 0; a < F; ++a)
+              if (findRoot(fanParent, a) != keep) {
+                group.push_back(fanTets[a]);
+                vol += volume(fanTets[a]);
+                gone[fanTets[a]] = 1;
+              }
+          }
+          grew = true;
+          continue;
+        }
+        if (count < 0) {
+          // A node whose star was already not a manifold one before (earlier cuts left it
+          // pinched) and stays so: the flap does not make it worse.
+          restored.clear();
+          for (int t : group)
+            if (has(t, v)) {
+              restored.push_back(t);
+              gone[t] = 0;
+            }
+          liveStar(v);
+          const int before = pieces(v);
+          for (int t : restored) gone[t] = 1;
+          if (before == -1) continue;
+          // The flap would open a hole through the surface around v (its star keeps one
+          // piece, but the boundary around v becomes two loops): open the hole to the
+          // boundary along the shortest chain of tets around v (at most kChain), so the
+          // boundary around v is one loop again ...
+          liveStar(v);
+          if (openHoleToBoundary(v)) {
+            grew = true;
+            continue;
+          }
+          // ... or keep the flap's tets at v where the worst tet is not among them and the
+          // rest is still a flap.
+          bool worstKept = false;
+          for (int t : restored) worstKept = worstKept || t == worstTet;
+          if (worstKept || restored.size() == group.size()) {
+              ok = false;
+            break;
+          }
+          for (int t : restored) {
+            gone[t] = 0;
+            vol -= volume(t);
+            group.erase(std::find(group.begin(), group.end(), t));
+          }
+          grew = true;
+          continue;
+        }
+        if (count <= 1) continue;
+        pieceVolume.assign(around.size(), 0.0);
+        for (size_t i = 0; i < around.size(); ++i) pieceVolume[pieceOf[i]] += volume(around[i]);
+        const int keep = static_cast<int>(std::max_element(pieceVolume.begin(), pieceVolume.end()) - pieceVolume.begin());
+        for (size_t i = 0; i < around.size(); ++i)
+          if (pieceOf[i] != keep) {
+            group.push_back(around[i]);
+            vol += volume(around[i]);
+            gone[around[i]] = 1;
+          }
+        grew = true;
+      }
+      if (!ok || !grew) break;
+      if (round >= 3 || static_cast<int>(group.size()) > options.flap_max_tets || vol > groupLimit || vol > passLeft)
+        ok = false;
+    }
+    // The tets next to the group must stay connected through the tets around the group's nodes.
+    if (ok) {
+      rim.clear();
+      for (int t : group)
+        for (int f = 0; f < 4; ++f) {
+          const int u = across(t, f);
+          if (u >= 0) rim.push_back(u);
+        }
+      std::sort(rim.begin(), rim.end());
+      rim.erase(std::unique(rim.begin(), rim.end()), rim.end());
+      // Walk from each rim tet through the live tets (at most kCap of them): the rim tets
+      // one walk reaches are connected; a walk that ends before kCap has found a closed piece
+      // that hung on the group only (a chip the sweep almost cut off, held by a neck thinner
+      // than the flap): it is freed, as the cut frees chips. Two walks that both reach kCap
+      // without meeting: the group is a bridge between large parts; refused.
+      constexpr int kCap = 256;
+      if (rim.size() > 1) {
+        if (mark.empty()) mark.assign(M, -1);
+        int big = 0;
+        for (size_t r = 0; r < rim.size() && ok; ++r) {
+          if (mark[rim[r]] >= 0) continue;
+          walked.assign(1, rim[r]);
+          mark[rim[r]] = static_cast<int>(r);
+          for (size_t i = 0; i < walked.size() && static_cast<int>(walked.size()) < kCap; ++i)
+            for (int f = 0; f < 4; ++f) {
+              const int u = across(walked[i], f);
+              if (u >= 0 && mark[u] < 0) {
+                mark[u] = static_cast<int>(r);
+                walked.push_back(u);
+              }
+            }
+          allWalked.insert(allWalked.end(), walked.begin(), walked.end());
+          if (static_cast<int>(walked.size()) >= kCap) {
+            ok = ++big <= 1;
+            continue;
+          }
+          // A closed piece: it hung on the group (a chip the sweep almost cut off); it is freed.
+        }
+        for (int t : allWalked) mark[t] = -1;
+        allWalked.clear();
+      }
+    }
+    if (!ok) {
+      for (int t : group) gone[t] = 0;
+      continue;
+    }
+    passLeft -= vol;
+    peeled += static_cast<int>(group.size());
+    peeledVolume += vol;
+  }
+  if (counts) {
+    counts->peeled += peeled;
+    counts->flap_peeled += peeled;
+    counts->peeled_volume += peeledVolume;
+  }
+}
+
+}  // namespace hysim::cutting
