@@ -42,6 +42,42 @@ TetMesh withoutChips(const TetMesh& mesh) {
   return out;
 }
 
+// A dumped pass of the default scene (tests/data/cutting/shave_<name>_{mesh,surface}.msh),
+// cut with `options`: the cut must succeed and leave a valid mesh. `in` receives the input.
+struct DumpedPass {
+  TetMesh in;
+  Cut3DResult out;
+  double q_kept = 0;  // q*_min of the tissue (chips left out)
+};
+::testing::AssertionResult cutDumpedPass(const std::string& name, const Cut3DOptions& options, DumpedPass* pass) {
+  const std::string dir = std::string(HYSIM_TEST_DATA_DIR) + "/cutting/shave_" + name;
+  auto mesh = readTetMesh(dir + "_mesh.msh");
+  if (!mesh.ok()) return ::testing::AssertionFailure() << mesh.error();
+  auto tris = readTriMesh(dir + "_surface.msh");
+  if (!tris.ok()) return ::testing::AssertionFailure() << tris.error();
+  auto surface = CutSurface::triangles(tris->X, tris->F);
+  if (!surface.ok()) return ::testing::AssertionFailure() << surface.error();
+  auto r = cut3d(*mesh, *surface, options);
+  if (!r.ok()) return ::testing::AssertionFailure() << r.error();
+  if (const Status v = validate(r->mesh); !v.ok()) return ::testing::AssertionFailure() << name << ": " << v.error();
+  pass->in = std::move(*mesh);
+  pass->out = std::move(*r);
+  pass->q_kept = computeStats(withoutChips(pass->out.mesh)).q_min;
+  return ::testing::AssertionSuccess();
+}
+
+// The flap cases' common acceptance: q*_min of the tissue >= 0.25x the initial mesh's, at most
+// 1.2x the elements, volume kept within 2e-4 (flaps are thin).
+constexpr double kInitialQ = 0.1062;  // assets/uterus_myoma.msh
+void expectFlapCaseAccepted(const std::string& name, const DumpedPass& p) {
+  std::printf("%s: q*_min %.4f (%.2fx the initial), %d tets in flaps\n", name.c_str(), p.q_kept, p.q_kept / kInitialQ,
+              p.out.report.flap_peeled);
+  EXPECT_GE(p.q_kept, 0.25 * kInitialQ);
+  EXPECT_LE(p.out.mesh.numTets(), 1.2 * p.in.numTets());
+  EXPECT_NEAR(totalVolume(p.out.mesh), totalVolume(p.in), 2e-4 * totalVolume(p.in));
+}
+
+
 TEST(ShaveQuality, SuccessiveSweepsKeepAQuarterOfTheInitialQuality) {
   const std::string path = std::string(HYSIM_SOURCE_DIR) + "/assets/uterus_myoma.msh";
   if (!std::filesystem::exists(path)) GTEST_SKIP() << "no " << path;
@@ -112,36 +148,18 @@ TEST(ShaveQuality, DumpedPassOverRoughBoundariesKeepsAQuarterOfTheInitialQuality
 // a chip. No single-tet peel, collapse or move repairs them (each peel alone leaves a pinched
 // edge); before flap peeling (flap_peel.cpp) the kept tissue's q*_min was 0.0044 (0.04x).
 TEST(ShaveQuality, ThinFlapsBetweenTheSweepAndTheBoundaryArePeeledAsAGroup) {
-  const std::string dir = std::string(HYSIM_TEST_DATA_DIR) + "/cutting/";
-  auto mesh = readTetMesh(dir + "shave_pass41_mesh.msh");
-  ASSERT_TRUE(mesh.ok()) << mesh.error();
-  auto tris = readTriMesh(dir + "shave_pass41_surface.msh");
-  ASSERT_TRUE(tris.ok()) << tris.error();
-  auto surface = CutSurface::triangles(tris->X, tris->F);
-  ASSERT_TRUE(surface.ok()) << surface.error();
-  const double q0 = 0.1062;  // assets/uterus_myoma.msh
-  auto r = cut3d(*mesh, *surface, Cut3DOptions{});
-  ASSERT_TRUE(r.ok()) << r.error();
-  const Status v = validate(r->mesh);
-  ASSERT_TRUE(v.ok()) << v.error();
-  EXPECT_GT(r->report.flap_peeled, 0);
-  const TetMesh kept = withoutChips(r->mesh);
-  const double q = computeStats(kept).q_min;
-  std::printf("pass 41: q*_min %.4f (%.2fx the initial), %d tets in flaps\n", q, q / q0, r->report.flap_peeled);
-  EXPECT_GE(q, 0.25 * q0);
-  EXPECT_LE(r->mesh.numTets(), 1.2 * mesh->numTets());
-  // Flaps are thin: the volume lost (peeling, chips included) stays small.
-  EXPECT_NEAR(totalVolume(r->mesh), totalVolume(*mesh), 2e-4 * totalVolume(*mesh));
+  DumpedPass p;
+  ASSERT_TRUE(cutDumpedPass("pass41", Cut3DOptions{}, &p));
+  EXPECT_GT(p.out.report.flap_peeled, 0);
+  expectFlapCaseAccepted("pass41", p);
   // Without flap peeling the mesh is valid but the flap stays.
   Cut3DOptions off;
   off.optimize.flap_quality = 0;
-  auto o = cut3d(*mesh, *surface, off);
-  ASSERT_TRUE(o.ok()) << o.error();
-  EXPECT_TRUE(validate(o->mesh).ok());
-  EXPECT_EQ(o->report.flap_peeled, 0);
-  EXPECT_LT(computeStats(withoutChips(o->mesh)).q_min, 0.25 * q0);
+  DumpedPass o;
+  ASSERT_TRUE(cutDumpedPass("pass41", off, &o));
+  EXPECT_EQ(o.out.report.flap_peeled, 0);
+  EXPECT_LT(o.q_kept, 0.25 * kInitialQ);
 }
-
 
 // Pass 45 of the default scene (from `hysim run scenes/default.yaml --dump-cuts DIR` on the
 // flap-quality branch, state hash 9545b076d460d431): the poor flap (q* 0.0021) touches a
@@ -149,24 +167,10 @@ TEST(ShaveQuality, ThinFlapsBetweenTheSweepAndTheBoundaryArePeeledAsAGroup) {
 // the flap is removed). Removing the flap does not make that node worse, so it is peeled;
 // before, such a flap was refused and the pass left q*_min 0.0021 (0.02x).
 TEST(ShaveQuality, FlapsAtANodeAlreadyPinchedBeforeThePassArePeeled) {
-  const std::string dir = std::string(HYSIM_TEST_DATA_DIR) + "/cutting/";
-  auto mesh = readTetMesh(dir + "shave_pass45_mesh.msh");
-  ASSERT_TRUE(mesh.ok()) << mesh.error();
-  auto tris = readTriMesh(dir + "shave_pass45_surface.msh");
-  ASSERT_TRUE(tris.ok()) << tris.error();
-  auto surface = CutSurface::triangles(tris->X, tris->F);
-  ASSERT_TRUE(surface.ok()) << surface.error();
-  const double q0 = 0.1062;  // assets/uterus_myoma.msh
-  auto r = cut3d(*mesh, *surface, Cut3DOptions{});
-  ASSERT_TRUE(r.ok()) << r.error();
-  const Status v = validate(r->mesh);
-  ASSERT_TRUE(v.ok()) << v.error();
-  EXPECT_GT(r->report.flap_peeled, 0);
-  const double q = computeStats(withoutChips(r->mesh)).q_min;
-  std::printf("pass 45: q*_min %.4f (%.2fx the initial), %d tets in flaps\n", q, q / q0, r->report.flap_peeled);
-  EXPECT_GE(q, 0.25 * q0);
-  EXPECT_LE(r->mesh.numTets(), 1.2 * mesh->numTets());
-  EXPECT_NEAR(totalVolume(r->mesh), totalVolume(*mesh), 2e-4 * totalVolume(*mesh));
+  DumpedPass p;
+  ASSERT_TRUE(cutDumpedPass("pass45", Cut3DOptions{}, &p));
+  EXPECT_GT(p.out.report.flap_peeled, 0);
+  expectFlapCaseAccepted("pass45", p);
 }
 
 // Pass 46 of the default scene (`hysim run scenes/default.yaml --dump-cuts DIR` on the
@@ -175,23 +179,9 @@ TEST(ShaveQuality, FlapsAtANodeAlreadyPinchedBeforeThePassArePeeled) {
 // so it was no seed and the flap was never looked at. Nodes on the cut are seeds of the flap
 // search too.
 TEST(ShaveQuality, FlapsAtNodesOnTheSweepTheCutDidNotTouchArePeeled) {
-  const std::string dir = std::string(HYSIM_TEST_DATA_DIR) + "/cutting/";
-  auto mesh = readTetMesh(dir + "shave_pass46_mesh.msh");
-  ASSERT_TRUE(mesh.ok()) << mesh.error();
-  auto tris = readTriMesh(dir + "shave_pass46_surface.msh");
-  ASSERT_TRUE(tris.ok()) << tris.error();
-  auto surface = CutSurface::triangles(tris->X, tris->F);
-  ASSERT_TRUE(surface.ok()) << surface.error();
-  const double q0 = 0.1062;  // assets/uterus_myoma.msh
-  auto r = cut3d(*mesh, *surface, Cut3DOptions{});
-  ASSERT_TRUE(r.ok()) << r.error();
-  const Status v = validate(r->mesh);
-  ASSERT_TRUE(v.ok()) << v.error();
-  const double q = computeStats(withoutChips(r->mesh)).q_min;
-  std::printf("pass 46: q*_min %.4f (%.2fx the initial), %d tets in flaps\n", q, q / q0, r->report.flap_peeled);
-  EXPECT_GE(q, 0.25 * q0);
-  EXPECT_LE(r->mesh.numTets(), 1.2 * mesh->numTets());
-  EXPECT_NEAR(totalVolume(r->mesh), totalVolume(*mesh), 2e-4 * totalVolume(*mesh));
+  DumpedPass p;
+  ASSERT_TRUE(cutDumpedPass("pass46", Cut3DOptions{}, &p));
+  expectFlapCaseAccepted("pass46", p);
 }
 
 // Pass 41 of the default scene on the flap-quality branch (`hysim run scenes/default.yaml
@@ -201,23 +191,9 @@ TEST(ShaveQuality, FlapsAtNodesOnTheSweepTheCutDidNotTouchArePeeled) {
 // the shortest chain of tets around the node, which removes the flap's last poor tet (q*
 // 0.0165) as well; before, the tets at that node were kept and the pass left 0.0165.
 TEST(ShaveQuality, AFlapThatWouldOpenAHoleAtANodeIsPeeledWithAChainToTheBoundary) {
-  const std::string dir = std::string(HYSIM_TEST_DATA_DIR) + "/cutting/";
-  auto mesh = readTetMesh(dir + "shave_pass41b_mesh.msh");
-  ASSERT_TRUE(mesh.ok()) << mesh.error();
-  auto tris = readTriMesh(dir + "shave_pass41b_surface.msh");
-  ASSERT_TRUE(tris.ok()) << tris.error();
-  auto surface = CutSurface::triangles(tris->X, tris->F);
-  ASSERT_TRUE(surface.ok()) << surface.error();
-  const double q0 = 0.1062;  // assets/uterus_myoma.msh
-  auto r = cut3d(*mesh, *surface, Cut3DOptions{});
-  ASSERT_TRUE(r.ok()) << r.error();
-  const Status v = validate(r->mesh);
-  ASSERT_TRUE(v.ok()) << v.error();
-  const double q = computeStats(withoutChips(r->mesh)).q_min;
-  std::printf("pass 41b: q*_min %.4f (%.2fx the initial), %d tets in flaps\n", q, q / q0, r->report.flap_peeled);
-  EXPECT_GE(q, 0.25 * q0);
-  EXPECT_LE(r->mesh.numTets(), 1.2 * mesh->numTets());
-  EXPECT_NEAR(totalVolume(r->mesh), totalVolume(*mesh), 2e-4 * totalVolume(*mesh));
+  DumpedPass p;
+  ASSERT_TRUE(cutDumpedPass("pass41b", Cut3DOptions{}, &p));
+  expectFlapCaseAccepted("pass41b", p);
 }
 
 // Pass 47 of the default scene on the flap-quality branch (`hysim run scenes/default.yaml
@@ -225,31 +201,16 @@ TEST(ShaveQuality, AFlapThatWouldOpenAHoleAtANodeIsPeeledWithAChainToTheBoundary
 // of the local edge) whose removal pinches a node; the repair takes the smaller piece of that
 // node's star with it (2.7 regular tets in all), within the default group limit (3.0).
 TEST(ShaveQuality, AFlatTetWhoseRepairTakesAPinchedPieceIsPeeledWithinTheGroupLimit) {
-  const std::string dir = std::string(HYSIM_TEST_DATA_DIR) + "/cutting/";
-  auto mesh = readTetMesh(dir + "shave_pass47_mesh.msh");
-  ASSERT_TRUE(mesh.ok()) << mesh.error();
-  auto tris = readTriMesh(dir + "shave_pass47_surface.msh");
-  ASSERT_TRUE(tris.ok()) << tris.error();
-  auto surface = CutSurface::triangles(tris->X, tris->F);
-  ASSERT_TRUE(surface.ok()) << surface.error();
-  const double q0 = 0.1062;  // assets/uterus_myoma.msh
-  auto r = cut3d(*mesh, *surface, Cut3DOptions{});
-  ASSERT_TRUE(r.ok()) << r.error();
-  const Status v = validate(r->mesh);
-  ASSERT_TRUE(v.ok()) << v.error();
-  const double q = computeStats(withoutChips(r->mesh)).q_min;
-  std::printf("pass 47: q*_min %.4f (%.2fx the initial), %d tets in flaps\n", q, q / q0, r->report.flap_peeled);
-  EXPECT_GE(q, 0.25 * q0);
-  EXPECT_LE(r->mesh.numTets(), 1.2 * mesh->numTets());
-  EXPECT_NEAR(totalVolume(r->mesh), totalVolume(*mesh), 2e-4 * totalVolume(*mesh));
+  DumpedPass p;
+  ASSERT_TRUE(cutDumpedPass("pass47", Cut3DOptions{}, &p));
+  expectFlapCaseAccepted("pass47", p);
   // With the earlier limits (1.5 per group, 3.0 per pass) the flat tet stays.
   Cut3DOptions tight;
   tight.optimize.flap_group_volume = 1.5;
   tight.optimize.flap_pass_volume = 3.0;
-  auto t = cut3d(*mesh, *surface, tight);
-  ASSERT_TRUE(t.ok()) << t.error();
-  EXPECT_TRUE(validate(t->mesh).ok());
-  EXPECT_LT(computeStats(withoutChips(t->mesh)).q_min, 0.25 * q0);
+  DumpedPass t;
+  ASSERT_TRUE(cutDumpedPass("pass47", tight, &t));
+  EXPECT_LT(t.q_kept, 0.25 * kInitialQ);
 }
 }  // namespace
 }  // namespace hysim::cutting
