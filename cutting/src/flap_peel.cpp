@@ -56,6 +56,65 @@ int findRoot(std::vector<int>& parent, int a) {
 
 }  // namespace
 
+StarShape starShape(const TetMesh& mesh, int v, const std::vector<std::int32_t>& around) {
+  StarShape shape;
+  const int S = static_cast<int>(around.size());
+  if (S == 0) {
+    shape.valid = true;
+    return shape;
+  }
+  // Each tet's three edges opposite v (a, b: the face (v, a, b)), sorted: two equal ones
+  // join their tets, a single one is a boundary edge of the link.
+  std::vector<std::array<std::int32_t, 3>> pairs;  // (a, b, index in around), a < b
+  pairs.reserve(3 * around.size());
+  for (int i = 0; i < S; ++i) {
+    std::int32_t o[3], m = 0;
+    for (int k = 0; k < 4; ++k)
+      if (mesh.T(around[i], k) != v && m < 3) o[m++] = mesh.T(around[i], k);
+    if (m != 3) return shape;
+    std::sort(o, o + 3);
+    pairs.push_back({o[0], o[1], i});
+    pairs.push_back({o[0], o[2], i});
+    pairs.push_back({o[1], o[2], i});
+  }
+  std::sort(pairs.begin(), pairs.end());
+  std::vector<int> piece(S);
+  std::iota(piece.begin(), piece.end(), 0);
+  std::vector<std::int32_t> ends;                  // boundary edges' end points, twice each
+  std::vector<std::array<std::int32_t, 2>> edges;  // boundary edges of the link
+  for (size_t i = 0; i < pairs.size();) {
+    size_t j = i;
+    while (j < pairs.size() && pairs[j][0] == pairs[i][0] && pairs[j][1] == pairs[i][1]) ++j;
+    if (j - i > 2) return shape;
+    if (j - i == 2) {
+      piece[findRoot(piece, pairs[i][2])] = findRoot(piece, pairs[i + 1][2]);
+    } else {
+      edges.push_back({pairs[i][0], pairs[i][1]});
+      ends.push_back(pairs[i][0]);
+      ends.push_back(pairs[i][1]);
+    }
+    i = j;
+  }
+  for (int i = 0; i < S; ++i) shape.pieces += findRoot(piece, i) == i;
+  std::sort(ends.begin(), ends.end());
+  for (size_t i = 0; i < ends.size();) {
+    size_t j = i;
+    while (j < ends.size() && ends[j] == ends[i]) ++j;
+    if (j - i != 2) return shape;  // a pinched edge (v, w), or an open link
+    i = j;
+  }
+  ends.erase(std::unique(ends.begin(), ends.end()), ends.end());
+  std::vector<int> loop(ends.size());
+  std::iota(loop.begin(), loop.end(), 0);
+  auto local = [&](int n) {
+    return static_cast<int>(std::lower_bound(ends.begin(), ends.end(), n) - ends.begin());
+  };
+  for (const auto& e : edges) loop[findRoot(loop, local(e[0]))] = findRoot(loop, local(e[1]));
+  for (size_t i = 0; i < ends.size(); ++i) shape.loops += findRoot(loop, static_cast<int>(i)) == static_cast<int>(i);
+  shape.valid = true;
+  return shape;
+}
+
 void peelFlaps(const TetMesh& mesh, const CutRegion& region, const std::vector<std::int32_t>& seeds,
                const Optimize3DOptions& options, std::vector<std::uint8_t>* dead, OptimizeCounts* counts) {
   const int N = mesh.numNodes(), M = mesh.numTets();

@@ -1048,6 +1048,23 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
             checked.push_back(w);
             liveStar(w, around, nullptr);
             ok = discAround(w, around);
+            if (!ok && curved) {
+              // Curved cuts: a node whose star earlier cuts had already left non-manifold
+              // (two sheets of the boundary touching at it) may stay so: the collapse is
+              // kept if that star has no more pieces and boundary loops than before.
+              const StarShape after = starShape(mesh, w, around);
+              for (int t : dying) (*dead)[t] = 0;
+              for (int t : changing)
+                for (int k = 0; k < 4; ++k)
+                  if (mesh.T(t, k) == v) mesh.T(t, k) = u;
+              liveStar(w, around, nullptr);
+              const StarShape before = starShape(mesh, w, around);
+              for (int t : dying) (*dead)[t] = 1;
+              for (int t : changing)
+                for (int k = 0; k < 4; ++k)
+                  if (mesh.T(t, k) == u) mesh.T(t, k) = v;
+              ok = !before.manifold() && after.noWorseThan(before);
+            }
           }
         if (!ok) {
           for (int t : dying) (*dead)[t] = 0;
