@@ -212,5 +212,20 @@ TEST(ShaveQuality, AFlatTetWhoseRepairTakesAPinchedPieceIsPeeledWithinTheGroupLi
   ASSERT_TRUE(cutDumpedPass("pass47", tight, &t));
   EXPECT_LT(t.q_kept, 0.25 * kInitialQ);
 }
+
+// Pass 52 of the default scene (`hysim run scenes/default.yaml --dump-cuts DIR` on main,
+// state hash 0243fdba20efbab9): the sweep leaves an edge of 0.055 mm on the cut (local edges
+// 5-8 mm) whose four tets are wedges (q* 0.0026-0.0045). Collapsing it is the repair, but one
+// node of those tets had a non-manifold star before the pass (one piece, two boundary loops:
+// earlier cuts left two sheets of the boundary touching there), so every collapse touching
+// it was refused, and flap peeling would have to take a 26 mm^3 tet with the flap. Such a
+// node may stay as it was (no more pieces or loops), as in flap peeling; before, the pass
+// left q*_min 0.0026 (0.02x).
+TEST(ShaveQuality, ACollapseNextToANodeAlreadyPinchedBeforeThePassIsKept) {
+  DumpedPass p;
+  ASSERT_TRUE(cutDumpedPass("pass52", Cut3DOptions{}, &p));
+  EXPECT_GT(p.out.report.collapsed_edges, 0);
+  expectFlapCaseAccepted("pass52", p);
+}
 }  // namespace
 }  // namespace hysim::cutting
