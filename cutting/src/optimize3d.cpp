@@ -885,6 +885,9 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   // does not fall), the volume changes by at most collapse_volume_fraction of the star and
   // within the budget, no two tets coincide and the mesh stays manifold. The node->tet lists are stale for the two ends until the next batch, so
   // within a batch they take part in no other collapse.
+  // Curved cuts, last (after flap peeling): only edges of tets below flap_quality, and a node
+  // already non-manifold may stay so (see below).
+  bool lastResort = false;
   auto collapseEdges = [&]() {
     if (!(options.collapse_fraction > 0)) return;
     std::vector<std::uint8_t> locked(N, 0);
@@ -910,6 +913,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       for (int t : seen) {
         if ((*dead)[t]) continue;
         const double q = tetQ(t);
+        if (lastResort && !(q < options.flap_quality)) continue;
         double mean = 0, lens[6];
         for (int a = 0, e = 0; a < 4; ++a)
           for (int b = a + 1; b < 4; ++b, ++e) {
@@ -1048,10 +1052,10 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
             checked.push_back(w);
             liveStar(w, around, nullptr);
             ok = discAround(w, around);
-            if (!ok && curved) {
-              // Curved cuts: a node whose star earlier cuts had already left non-manifold
-              // (two sheets of the boundary touching at it) may stay so: the collapse is
-              // kept if that star has no more pieces and boundary loops than before.
+            if (!ok && lastResort) {
+              // Last resort: a node whose star earlier cuts had already left non-manifold
+              // (two sheets of the boundary touching at it) may stay so, if its star has no
+              // more pieces and boundary loops than before.
               const StarShape after = starShape(mesh, w, around);
               for (int t : dying) (*dead)[t] = 0;
               for (int t : changing)
@@ -1438,7 +1442,14 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       if (didMove[n]) moved->push_back(n);
   if (moved) moved->insert(moved->end(), lateSnapped.begin(), lateSnapped.end());
   if (counts) counts->onto_cut = lateSnapped;
-  if (curved) peelFlaps(mesh, region, seeds, options, dead, counts);  // flap_peel.cpp
+  if (curved) {
+    peelFlaps(mesh, region, seeds, options, dead, counts);  // flap_peel.cpp
+    // Tets below flap_quality that no repair removed, around a node earlier cuts left
+    // non-manifold (every collapse there was refused): collapse their edges, the node
+    // staying as it was.
+    lastResort = true;
+    collapseEdges();
+  }
 }
 
 }  // namespace hysim::cutting
