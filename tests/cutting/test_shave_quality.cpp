@@ -219,8 +219,9 @@ TEST(ShaveQuality, AFlatTetWhoseRepairTakesAPinchedPieceIsPeeledWithinTheGroupLi
 // node of those tets had a non-manifold star before the pass (one piece, two boundary loops:
 // earlier cuts left two sheets of the boundary touching there), so every collapse touching
 // it was refused, and flap peeling would have to take a 26 mm^3 tet with the flap. Such a
-// node may stay as it was (no more pieces or loops), as in flap peeling; before, the pass
-// left q*_min 0.0026 (0.02x).
+// node may stay as it was (no more pieces or loops), as in flap peeling, in a last collapse
+// round after flap peeling for the tets still below flap_quality; before, the pass left
+// q*_min 0.0026 (0.02x).
 TEST(ShaveQuality, ACollapseNextToANodeAlreadyPinchedBeforeThePassIsKept) {
   DumpedPass p;
   ASSERT_TRUE(cutDumpedPass("pass52", Cut3DOptions{}, &p));
