@@ -267,7 +267,13 @@ Status updateModelAfterCut3D(Model& model, const cutting::TetMesh& before, const
   }
   std::vector<double> volume(static_cast<size_t>(T1), std::nan(""));
   auto tetVolume = [&](int t) {
-    if (std::isnan(volume[t])) volume[t] = cutting::tetVolume(after, t);
+    if (std::isnan(volume[t])) {  // cutting::tetVolume's arithmetic, inlined
+      const Eigen::Vector3d x0 = after.X.row(after.T(t, 0));
+      const Eigen::Vector3d x1 = after.X.row(after.T(t, 1));
+      const Eigen::Vector3d x2 = after.X.row(after.T(t, 2));
+      const Eigen::Vector3d x3 = after.X.row(after.T(t, 3));
+      volume[t] = (x1 - x0).dot((x2 - x0).cross(x3 - x0)) / 6.0;
+    }
     return volume[t];
   };
 
@@ -298,8 +304,15 @@ Status updateModelAfterCut3D(Model& model, const cutting::TetMesh& before, const
   };
   for (int t = 0; t < T0; ++t)
     if (change.element_old_to_new[t] < 0) touchOld(t);
+  const std::int32_t* after_col[4] = {after.T.col(0).data(), after.T.col(1).data(), after.T.col(2).data(),
+                                       after.T.col(3).data()};
+  const std::int32_t* before_col[4] = {before.T.col(0).data(), before.T.col(1).data(), before.T.col(2).data(),
+                                        before.T.col(3).data()};
   for (int t = 0; t < T1; ++t) {
     const int o = old_of[t];
+    if (o >= 0 && after_col[0][t] == o2n[before_col[0][o]] && after_col[1][t] == o2n[before_col[1][o]] &&
+        after_col[2][t] == o2n[before_col[2][o]] && after_col[3][t] == o2n[before_col[3][o]])
+      continue;  // the same nodes in the same order: most elements
     bool same = o >= 0;
     if (same) {
       std::array<int, 4> a{}, b{};
@@ -356,13 +369,19 @@ Status updateModelAfterCut3D(Model& model, const cutting::TetMesh& before, const
     if (j >= 0 && !region[j]) mass[j] = model.mass[i];
   }
   std::vector<int> unknown;
-  for (int j : region_nodes) {
-    double lumped = 0.0;
-    for (int e = off[j]; e < off[j + 1]; ++e)
-      lumped += 0.25 * model.materials[material[around[e]]].density_g_mm3 * std::abs(tetVolume(around[e]));
-    mass[j] = lumped;
-    if (lumped > 0.0) unknown.push_back(j);
+  // Lumped priors: a quarter of each incident tet's mass, summed over a node's tets in
+  // increasing order (one pass over the tets, each volume computed once).
+  for (int t = 0; t < T1; ++t) {
+    const int n0 = after.T(t, 0), n1 = after.T(t, 1), n2 = after.T(t, 2), n3 = after.T(t, 3);
+    if (!(region[n0] | region[n1] | region[n2] | region[n3])) continue;
+    const double w = 0.25 * model.materials[material[t]].density_g_mm3 * std::abs(tetVolume(t));
+    if (region[n0]) mass[n0] += w;
+    if (region[n1]) mass[n1] += w;
+    if (region[n2]) mass[n2] += w;
+    if (region[n3]) mass[n3] += w;
   }
+  for (int j : region_nodes)
+    if (mass[j] > 0.0) unknown.push_back(j);
   if (!unknown.empty()) {
     Eigen::Vector3d lo = after.X.row(unknown[0]).transpose(), hi = lo;
     for (int j : unknown) {
@@ -397,13 +416,9 @@ Status updateModelAfterCut3D(Model& model, const cutting::TetMesh& before, const
     int a, b;
     double rest, k, c;
   };
+  // The unchanged ones stay in the model's arrays (compacted in place below, once nothing
+  // can fail); `springs` collects the recomputed ones, which follow them.
   std::vector<Spring> springs;
-  springs.reserve(static_cast<size_t>(model.springs.rows()) + 64);
-  for (Eigen::Index s = 0; s < model.springs.rows(); ++s) {
-    const int a = o2n[model.springs(s, 0)], b = o2n[model.springs(s, 1)];
-    if (a < 0 || b < 0 || (touched[a] && touched[b])) continue;
-    springs.push_back({a, b, model.rest_length[s], model.stiffness[s], model.damping[s]});
-  }
   // Each (tet, edge) with both ends touched, sorted by (smaller node, larger node), an edge's
   // tets in increasing order (the order buildModel sums them in): two stable counting sorts,
   // by the larger node, then by the smaller.
@@ -491,13 +506,26 @@ Status updateModelAfterCut3D(Model& model, const cutting::TetMesh& before, const
   m.inv_mass = Eigen::VectorXd::Zero(N2);
   for (int i = 0; i < N2; ++i)
     if (!m.fixed[i]) m.inv_mass[i] = 1.0 / m.mass[i];
-  int ns = 0;
+  // Unchanged springs, compacted in place (a row is read before any row at or above it is
+  // written), then the recomputed ones: the order of a full copy.
+  Eigen::Index out = 0;
+  for (Eigen::Index s = 0; s < m.springs.rows(); ++s) {
+    const int a = o2n[m.springs(s, 0)], b = o2n[m.springs(s, 1)];
+    if (a < 0 || b < 0 || (touched[a] && touched[b]) || keep[a] < 0 || keep[b] < 0) continue;
+    m.springs(out, 0) = keep[a];
+    m.springs(out, 1) = keep[b];
+    m.rest_length[out] = m.rest_length[s];
+    m.stiffness[out] = m.stiffness[s];
+    m.damping[out] = m.damping[s];
+    ++out;
+  }
+  Eigen::Index ns = out;
   for (const Spring& s : springs) ns += (keep[s.a] >= 0 && keep[s.b] >= 0) ? 1 : 0;
-  m.springs.resize(ns, 2);
-  m.rest_length.resize(ns);
-  m.stiffness.resize(ns);
-  m.damping.resize(ns);
-  for (int s = 0, out = 0; s < static_cast<int>(springs.size()); ++s) {
+  m.springs.conservativeResize(ns, 2);
+  m.rest_length.conservativeResize(ns);
+  m.stiffness.conservativeResize(ns);
+  m.damping.conservativeResize(ns);
+  for (int s = 0; s < static_cast<int>(springs.size()); ++s) {
     const Spring& sp = springs[s];
     if (keep[sp.a] < 0 || keep[sp.b] < 0) continue;
     m.springs(out, 0) = keep[sp.a];
