@@ -7,8 +7,9 @@
 // (sim::updateModelAfterCut3D, the simulator's incremental update, or sim::updateModel3D, a
 // whole rebuild; then sim::remapState3D).
 // The benchmark's time is the whole (cut + optimisation + TopologyChange + update); the
-// counters split it: cut_ms (cut3d, incl. optimisation), optimize_ms, update_ms. Medians over
-// the repetitions (the `_median` rows). Run from anywhere:
+// counters split it: cut_ms (cut3d, incl. optimisation), optimize_ms, update_ms (wall-clock
+// means), update_cpu_med_ms (BM_Cut3DUpdate: the update's median thread CPU time, steadier
+// than the wall clock on a loaded machine). Medians over the repetitions (the `_median` rows). Run from anywhere:
 //   ./build/bench/bench_cut3d --benchmark_filter='BM_Cut3DUpdate/./././1'   (incremental)
 // BM_Cut3DReplay: recorded shaving passes (HYSIM_REPLAY_DIR, see below).
 // BM_Cut3DSurface: the same meshes cut by a curved swept strip (the shaving passes' surfaces):
@@ -17,6 +18,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <ctime>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -125,6 +127,7 @@ void BM_Cut3DUpdate(benchmark::State& state) {
   const auto surface = planeThrough(p.mesh, plane);
   const bool incremental = state.range(3) != 0;
   double cutMs = 0, optMs = 0, updMs = 0;
+  std::vector<double> updCpu;
   int elements = 0, nodes = 0;
   hysim::sim::Model model;
   std::vector<std::uint8_t> fixed;
@@ -141,6 +144,8 @@ void BM_Cut3DUpdate(benchmark::State& state) {
       state.SkipWithError(r.error().c_str());
       return;
     }
+    timespec c0, c1;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &c0);
     if (incremental) {
       const auto st = incrementalUpdate(p, *r, model, fixed);
       if (!st.ok()) {
@@ -157,6 +162,8 @@ void BM_Cut3DUpdate(benchmark::State& state) {
     }
     auto s = hysim::sim::remapState3D(p.state, r->change);
     const auto t2 = std::chrono::steady_clock::now();
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &c1);
+    updCpu.push_back((c1.tv_sec - c0.tv_sec) * 1e3 + (c1.tv_nsec - c0.tv_nsec) * 1e-6);
     benchmark::DoNotOptimize(s);
     benchmark::DoNotOptimize(model);
     cutMs += std::chrono::duration<double, std::milli>(t1 - t0).count();
@@ -169,6 +176,8 @@ void BM_Cut3DUpdate(benchmark::State& state) {
   state.counters["cut_ms"] = cutMs / n;
   state.counters["optimize_ms"] = optMs / n;
   state.counters["update_ms"] = updMs / n;
+  std::sort(updCpu.begin(), updCpu.end());
+  if (!updCpu.empty()) state.counters["update_cpu_med_ms"] = updCpu[updCpu.size() / 2];
   state.counters["tets"] = elements;
   state.counters["nodes"] = nodes;
   state.SetLabel(p.name + " plane " + std::to_string(plane) + " " + hysim::cutting::cutMethodName(o.method) +

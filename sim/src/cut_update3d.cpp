@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include "hysim/sim/tissue_update3d.hpp"
@@ -25,72 +26,75 @@ double topEigenvalue(const Model& m, const cutting::Positions& X, const std::vec
   const StepSprings& st = m.step_springs;
   std::vector<int> local(static_cast<size_t>(m.num_nodes), -1);
   for (int k = 0; k < count; ++k) local[nodes[k]] = k;
-  struct LocalSpring {
-    int a, b;  // local indices, -1 = held fixed
-    double dx, dy, dz, k, sa, sb;
+  // The operator, with y = M^-1/2 u: a spring between free nodes contributes t = k d.(y_b - y_a)
+  // to z_b along d and its negative to z_a; with w = sqrt(k) d / sqrt(m) at each end that is
+  // t = w_b.u_b - w_a.u_a, z_a -= t w_a, z_b += t w_b. A spring to a held node (y = 0 there)
+  // only adds (w.u_i) w at its free end: summed per node into a symmetric 3x3 block.
+  struct FreeSpring {
+    int a, b;  // 3 * local index
+    double wa[3], wb[3];
   };
-  std::vector<LocalSpring> springs;
-  springs.reserve(static_cast<size_t>(count) * 8);
+  std::vector<FreeSpring> springs;
+  springs.reserve(static_cast<size_t>(count) * 7);
+  std::vector<double> held_block(6 * static_cast<size_t>(count), 0.0);  // xx yy zz xy yz zx
   for (int k = 0; k < count; ++k) {
     const int node = nodes[k];
     for (int e = st.node_offset[node]; e < st.node_offset[node + 1]; ++e) {
       const int s = st.incident[e];
       const int a = st.a[s], b = st.b[s];
       const int other = a == node ? b : a;
-      if (local[other] >= 0 && local[other] < k) continue;  // taken at the other end
-      LocalSpring ls;
-      ls.a = m.fixed[a] ? -1 : local[a];
-      ls.b = m.fixed[b] ? -1 : local[b];
+      const int la = m.fixed[a] ? -1 : local[a], lb = m.fixed[b] ? -1 : local[b];
+      if (la >= 0 && lb >= 0 && local[other] < k) continue;  // taken at the other end
       Eigen::RowVector3d d = X.row(b) - X.row(a);
       d /= d.norm();
-      ls.dx = d[0];
-      ls.dy = d[1];
-      ls.dz = d[2];
-      ls.k = st.stiffness[s];
-      ls.sa = ls.a >= 0 ? 1.0 / std::sqrt(m.mass[a]) : 0.0;
-      ls.sb = ls.b >= 0 ? 1.0 / std::sqrt(m.mass[b]) : 0.0;
-      springs.push_back(ls);
+      const double sk = std::sqrt(st.stiffness[s]);
+      if (la >= 0 && lb >= 0) {
+        FreeSpring fs;
+        fs.a = 3 * la;
+        fs.b = 3 * lb;
+        const double ca = sk / std::sqrt(m.mass[a]), cb = sk / std::sqrt(m.mass[b]);
+        for (int c = 0; c < 3; ++c) {
+          fs.wa[c] = ca * d[c];
+          fs.wb[c] = cb * d[c];
+        }
+        springs.push_back(fs);
+      } else if (la == k || lb == k) {  // this node free, the other end held
+        const Eigen::RowVector3d w = d * (sk / std::sqrt(m.mass[node]));
+        double* h = &held_block[6 * static_cast<size_t>(k)];
+        h[0] += w[0] * w[0];
+        h[1] += w[1] * w[1];
+        h[2] += w[2] * w[2];
+        h[3] += w[0] * w[1];
+        h[4] += w[1] * w[2];
+        h[5] += w[2] * w[0];
+      }
     }
   }
   const Eigen::Index n3 = 3 * static_cast<Eigen::Index>(count);
-  // Structure of arrays, a held end pointing at a zero slot past the free ones (its scale
-  // is 0 and its row of the result is dropped): no branches, the same arithmetic as with
-  // them (0 * 0 added or subtracted leaves a value as it is).
-  const size_t ns = springs.size();
-  std::vector<int> ia(ns), ib(ns);
-  std::vector<double> sdx(ns), sdy(ns), sdz(ns), sk(ns), ssa(ns), ssb(ns);
-  for (size_t i = 0; i < ns; ++i) {
-    const LocalSpring& ls = springs[i];
-    ia[i] = 3 * (ls.a >= 0 ? ls.a : count);
-    ib[i] = 3 * (ls.b >= 0 ? ls.b : count);
-    sdx[i] = ls.dx;
-    sdy[i] = ls.dy;
-    sdz[i] = ls.dz;
-    sk[i] = ls.k;
-    ssa[i] = ls.sa;
-    ssb[i] = ls.sb;
-  }
-  Eigen::VectorXd u_pad = Eigen::VectorXd::Zero(n3 + 3), z_pad(n3 + 3);
   auto apply = [&](const Eigen::VectorXd& u, Eigen::VectorXd& z) {
-    u_pad.head(n3) = u;
-    z_pad.setZero();
-    const double* up = u_pad.data();
-    double* zp = z_pad.data();
-    for (size_t i = 0; i < ns; ++i) {
-      const int a = ia[i], b = ib[i];
-      const double sa = ssa[i], sb = ssb[i], dx = sdx[i], dy = sdy[i], dz = sdz[i];
-      const double yx = sb * up[b] - sa * up[a];
-      const double yy = sb * up[b + 1] - sa * up[a + 1];
-      const double yz = sb * up[b + 2] - sa * up[a + 2];
-      const double t = sk[i] * (yx * dx + yy * dy + yz * dz);  // (K y)_b = t d, (K y)_a = -t d
-      zp[a] -= sa * t * dx;
-      zp[a + 1] -= sa * t * dy;
-      zp[a + 2] -= sa * t * dz;
-      zp[b] += sb * t * dx;
-      zp[b + 1] += sb * t * dy;
-      zp[b + 2] += sb * t * dz;
+    const double* up = u.data();
+    double* zp = z.data();
+    const double* h = held_block.data();
+    for (int k = 0; k < count; ++k, h += 6) {
+      const double x = up[3 * k], y = up[3 * k + 1], w = up[3 * k + 2];
+      zp[3 * k] = h[0] * x + h[3] * y + h[5] * w;
+      zp[3 * k + 1] = h[3] * x + h[1] * y + h[4] * w;
+      zp[3 * k + 2] = h[5] * x + h[4] * y + h[2] * w;
     }
-    z = z_pad.head(n3);
+    for (const FreeSpring& fs : springs) {
+      const double* ua = up + fs.a;
+      const double* ub = up + fs.b;
+      const double t = (fs.wb[0] * ub[0] + fs.wb[1] * ub[1] + fs.wb[2] * ub[2]) -
+                       (fs.wa[0] * ua[0] + fs.wa[1] * ua[1] + fs.wa[2] * ua[2]);
+      double* za = zp + fs.a;
+      double* zb = zp + fs.b;
+      za[0] -= t * fs.wa[0];
+      za[1] -= t * fs.wa[1];
+      za[2] -= t * fs.wa[2];
+      zb[0] += t * fs.wb[0];
+      zb[1] += t * fs.wb[1];
+      zb[2] += t * fs.wb[2];
+    }
   };
   // Start: the alternating pattern of buildModel's power iteration (excites the highest
   // modes), plus the given vector.
@@ -140,25 +144,32 @@ double topEigenvalue(const Model& m, const cutting::Positions& X, const std::vec
     tri_sub.resize(size - 1);
     for (int i = 0; i < size; ++i) tri_diag[i] = alpha[i] / scale;
     for (int i = 0; i + 1 < size; ++i) tri_sub[i] = beta[i] / scale;
+    // Eigenvalues only until theta has settled: the Ritz vector (for the residual and the
+    // mode) is needed only from then on.
     if (size == 1) {
       theta = alpha[0];
       ritz = Eigen::VectorXd::Ones(1);
     } else {
-      eig.computeFromTridiagonal(tri_diag, tri_sub, Eigen::ComputeEigenvectors);
+      eig.computeFromTridiagonal(tri_diag, tri_sub, Eigen::EigenvaluesOnly);
       theta = eig.eigenvalues()[size - 1] * scale;
-      ritz = eig.eigenvectors().col(size - 1);
     }
     if (steps_taken) *steps_taken = size;
     // Converged: the top Ritz pair's residual is small (theta is near *an* eigenvalue) and
     // theta has stopped growing over the last steps (it rises towards the top one; near the
     // top the spectrum is dense, so a small residual alone can stop below it).
-    const double residual = b * std::abs(ritz[size - 1]);
     history.push_back(theta);
     const bool settled = size > options.lanczos_min_steps &&
                          theta - history[history.size() - 6] <= options.lanczos_tolerance * std::abs(theta);
-    if ((residual <= options.lanczos_tolerance * std::abs(theta) && settled) || b <= 1e-14 * std::abs(theta) ||
-        j + 1 == max_steps)
-      break;
+    const bool last = b <= 1e-14 * std::abs(theta) || j + 1 == max_steps;
+    if (settled || last) {
+      if (size > 1) {
+        eig.computeFromTridiagonal(tri_diag, tri_sub, Eigen::ComputeEigenvectors);
+        theta = eig.eigenvalues()[size - 1] * scale;
+        ritz = eig.eigenvectors().col(size - 1);
+      }
+      const double residual = b * std::abs(ritz[size - 1]);
+      if ((residual <= options.lanczos_tolerance * std::abs(theta) && settled) || last) break;
+    }
     beta.push_back(b);
     q = z / b;
   }
@@ -170,6 +181,47 @@ double topEigenvalue(const Model& m, const cutting::Positions& X, const std::vec
       for (int c = 0; c < 3; ++c) (*mode)(nodes[k], c) = norm > 0 ? y[3 * k + c] / norm : 0.0;
   }
   return std::max(theta, 0.0);
+}
+
+// An upper bound of the top eigenvalue of M^-1/2 K M^-1/2 over the free nodes `nodes`, every
+// other node held fixed (the matrix topEigenvalue estimates from below). With y = M^-1/2 u
+// (zero at held nodes) and S_i = sum of k_s d_s d_s^T over the springs at node i,
+//   u^T A u = sum_s k_s (d_s . (y_b - y_a))^2 <= sum_s 2 k_s ((d_s . y_a)^2 + (d_s . y_b)^2)
+//           <= sum_i 2 y_i^T S_i y_i <= max_i (2 lambda_max(S_i) / m_i) |u|^2
+// (a held end's term is dropped, which only lowers the middle sums). One pass over the
+// springs of `nodes` (it stops once above `stop_above`); lambda_max(S_i) is taken from the
+// closed form plus 1e-6 of the trace (its round-off stays far below that).
+double topEigenvalueBound(const Model& m, const cutting::Positions& X, const std::vector<int>& nodes, double stop_above) {
+  const StepSprings& st = m.step_springs;
+  double bound = 0.0;
+  for (int node : nodes) {
+    double s00 = 0, s11 = 0, s22 = 0, s01 = 0, s12 = 0, s20 = 0;
+    for (int e = st.node_offset[node]; e < st.node_offset[node + 1]; ++e) {
+      const int s = st.incident[e];
+      const int a = st.a[s], b = st.b[s];
+      const double dx = X(b, 0) - X(a, 0), dy = X(b, 1) - X(a, 1), dz = X(b, 2) - X(a, 2);
+      const double len2 = dx * dx + dy * dy + dz * dz;
+      if (!(len2 > 0.0)) return std::numeric_limits<double>::infinity();
+      const double c = st.stiffness[s] / len2;
+      s00 += c * dx * dx;
+      s11 += c * dy * dy;
+      s22 += c * dz * dz;
+      s01 += c * dx * dy;
+      s12 += c * dy * dz;
+      s20 += c * dz * dx;
+    }
+    const double trace = s00 + s11 + s22;
+    if (!(trace > 0.0)) continue;
+    if (2.0 * trace / m.mass[node] <= bound) continue;  // lambda_max(S) <= trace
+    Eigen::Matrix3d S;
+    S << s00, s01, s20, s01, s11, s12, s20, s12, s22;
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
+    eig.computeDirect(S, Eigen::EigenvaluesOnly);
+    const double top = std::min(trace, eig.eigenvalues()[2] + 1e-6 * trace);
+    bound = std::max(bound, 2.0 * top / m.mass[node]);
+    if (bound > stop_above) return bound;  // decided: above
+  }
+  return bound;
 }
 
 }  // namespace
@@ -215,7 +267,13 @@ Status updateModelAfterCut3D(Model& model, const cutting::TetMesh& before, const
   }
   std::vector<double> volume(static_cast<size_t>(T1), std::nan(""));
   auto tetVolume = [&](int t) {
-    if (std::isnan(volume[t])) volume[t] = cutting::tetVolume(after, t);
+    if (std::isnan(volume[t])) {  // cutting::tetVolume's arithmetic, inlined
+      const Eigen::Vector3d x0 = after.X.row(after.T(t, 0));
+      const Eigen::Vector3d x1 = after.X.row(after.T(t, 1));
+      const Eigen::Vector3d x2 = after.X.row(after.T(t, 2));
+      const Eigen::Vector3d x3 = after.X.row(after.T(t, 3));
+      volume[t] = (x1 - x0).dot((x2 - x0).cross(x3 - x0)) / 6.0;
+    }
     return volume[t];
   };
 
@@ -246,8 +304,15 @@ Status updateModelAfterCut3D(Model& model, const cutting::TetMesh& before, const
   };
   for (int t = 0; t < T0; ++t)
     if (change.element_old_to_new[t] < 0) touchOld(t);
+  const std::int32_t* after_col[4] = {after.T.col(0).data(), after.T.col(1).data(), after.T.col(2).data(),
+                                       after.T.col(3).data()};
+  const std::int32_t* before_col[4] = {before.T.col(0).data(), before.T.col(1).data(), before.T.col(2).data(),
+                                        before.T.col(3).data()};
   for (int t = 0; t < T1; ++t) {
     const int o = old_of[t];
+    if (o >= 0 && after_col[0][t] == o2n[before_col[0][o]] && after_col[1][t] == o2n[before_col[1][o]] &&
+        after_col[2][t] == o2n[before_col[2][o]] && after_col[3][t] == o2n[before_col[3][o]])
+      continue;  // the same nodes in the same order: most elements
     bool same = o >= 0;
     if (same) {
       std::array<int, 4> a{}, b{};
@@ -304,13 +369,19 @@ Status updateModelAfterCut3D(Model& model, const cutting::TetMesh& before, const
     if (j >= 0 && !region[j]) mass[j] = model.mass[i];
   }
   std::vector<int> unknown;
-  for (int j : region_nodes) {
-    double lumped = 0.0;
-    for (int e = off[j]; e < off[j + 1]; ++e)
-      lumped += 0.25 * model.materials[material[around[e]]].density_g_mm3 * std::abs(tetVolume(around[e]));
-    mass[j] = lumped;
-    if (lumped > 0.0) unknown.push_back(j);
+  // Lumped priors: a quarter of each incident tet's mass, summed over a node's tets in
+  // increasing order (one pass over the tets, each volume computed once).
+  for (int t = 0; t < T1; ++t) {
+    const int n0 = after.T(t, 0), n1 = after.T(t, 1), n2 = after.T(t, 2), n3 = after.T(t, 3);
+    if (!(region[n0] | region[n1] | region[n2] | region[n3])) continue;
+    const double w = 0.25 * model.materials[material[t]].density_g_mm3 * std::abs(tetVolume(t));
+    if (region[n0]) mass[n0] += w;
+    if (region[n1]) mass[n1] += w;
+    if (region[n2]) mass[n2] += w;
+    if (region[n3]) mass[n3] += w;
   }
+  for (int j : region_nodes)
+    if (mass[j] > 0.0) unknown.push_back(j);
   if (!unknown.empty()) {
     Eigen::Vector3d lo = after.X.row(unknown[0]).transpose(), hi = lo;
     for (int j : unknown) {
@@ -345,13 +416,9 @@ Status updateModelAfterCut3D(Model& model, const cutting::TetMesh& before, const
     int a, b;
     double rest, k, c;
   };
+  // The unchanged ones stay in the model's arrays (compacted in place below, once nothing
+  // can fail); `springs` collects the recomputed ones, which follow them.
   std::vector<Spring> springs;
-  springs.reserve(static_cast<size_t>(model.springs.rows()) + 64);
-  for (Eigen::Index s = 0; s < model.springs.rows(); ++s) {
-    const int a = o2n[model.springs(s, 0)], b = o2n[model.springs(s, 1)];
-    if (a < 0 || b < 0 || (touched[a] && touched[b])) continue;
-    springs.push_back({a, b, model.rest_length[s], model.stiffness[s], model.damping[s]});
-  }
   // Each (tet, edge) with both ends touched, sorted by (smaller node, larger node), an edge's
   // tets in increasing order (the order buildModel sums them in): two stable counting sorts,
   // by the larger node, then by the smaller.
@@ -439,13 +506,26 @@ Status updateModelAfterCut3D(Model& model, const cutting::TetMesh& before, const
   m.inv_mass = Eigen::VectorXd::Zero(N2);
   for (int i = 0; i < N2; ++i)
     if (!m.fixed[i]) m.inv_mass[i] = 1.0 / m.mass[i];
-  int ns = 0;
+  // Unchanged springs, compacted in place (a row is read before any row at or above it is
+  // written), then the recomputed ones: the order of a full copy.
+  Eigen::Index out = 0;
+  for (Eigen::Index s = 0; s < m.springs.rows(); ++s) {
+    const int a = o2n[m.springs(s, 0)], b = o2n[m.springs(s, 1)];
+    if (a < 0 || b < 0 || (touched[a] && touched[b]) || keep[a] < 0 || keep[b] < 0) continue;
+    m.springs(out, 0) = keep[a];
+    m.springs(out, 1) = keep[b];
+    m.rest_length[out] = m.rest_length[s];
+    m.stiffness[out] = m.stiffness[s];
+    m.damping[out] = m.damping[s];
+    ++out;
+  }
+  Eigen::Index ns = out;
   for (const Spring& s : springs) ns += (keep[s.a] >= 0 && keep[s.b] >= 0) ? 1 : 0;
-  m.springs.resize(ns, 2);
-  m.rest_length.resize(ns);
-  m.stiffness.resize(ns);
-  m.damping.resize(ns);
-  for (int s = 0, out = 0; s < static_cast<int>(springs.size()); ++s) {
+  m.springs.conservativeResize(ns, 2);
+  m.rest_length.conservativeResize(ns);
+  m.stiffness.conservativeResize(ns);
+  m.damping.conservativeResize(ns);
+  for (int s = 0; s < static_cast<int>(springs.size()); ++s) {
     const Spring& sp = springs[s];
     if (keep[sp.a] < 0 || keep[sp.b] < 0) continue;
     m.springs(out, 0) = keep[sp.a];
@@ -490,7 +570,25 @@ Status updateModelAfterCut3D(Model& model, const cutting::TetMesh& before, const
     if (!m.fixed[i] && (rep.global_stability || near[i])) estimate_nodes.push_back(i);
   rep.stability_nodes = static_cast<int>(estimate_nodes.size());
   bool carried = false;  // omega_max is the previous estimate (scaling near the cut cannot lower it)
+  auto carryPrevious = [&]() {
+    m.omega_max = rep.omega_previous;
+    m.stability_mode = mapped_mode;
+    m.stability_held = mode_near_cut && held_before >= 0 ? held_before + 1 : held_before;
+    rep.held_stability = mode_near_cut;
+    carried = true;
+    m.critical_dt = stabilityLimit(m.omega_max);
+  };
   auto estimate = [&]() {
+    if (!rep.global_stability) {
+      // Near the cut, an upper bound below the previous estimate settles what a Lanczos
+      // estimate (a lower one) would: the previous estimate is carried over.
+      const double bound = topEigenvalueBound(m, X, estimate_nodes, rep.omega_previous * rep.omega_previous);
+      if (bound * (1.0 + 1e-9) < rep.omega_previous * rep.omega_previous) {
+        rep.omega_local = std::sqrt(bound);
+        carryPrevious();
+        return;
+      }
+    }
     Eigen::MatrixX3d ritz;
     int steps = 0;
     const double lambda =
@@ -505,14 +603,10 @@ Status updateModelAfterCut3D(Model& model, const cutting::TetMesh& before, const
       m.stability_held = rep.global_stability || held_before >= 0 ? 0 : -1;
       rep.held_stability = false;
       carried = false;
+      m.critical_dt = stabilityLimit(m.omega_max);
     } else {
-      m.omega_max = rep.omega_previous;
-      m.stability_mode = mapped_mode;
-      m.stability_held = mode_near_cut && held_before >= 0 ? held_before + 1 : held_before;
-      rep.held_stability = mode_near_cut;
-      carried = true;
+      carryPrevious();
     }
-    m.critical_dt = stabilityLimit(m.omega_max);
   };
   estimate();
   // Selective mass scaling, as buildModel, on the nodes of the estimate.

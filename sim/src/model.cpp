@@ -59,36 +59,45 @@ double estimateOmegaMax(const Model& m, const cutting::Positions& X, Eigen::Matr
 }  // namespace
 
 void buildStepSprings(Model& m) {
-  // A spring between two anchored nodes never changes length: the step skips it.
+  // A spring between two anchored nodes never changes length: the step skips it. Sized by a
+  // counting pass and filled by index (the arrays keep their capacity between calls).
   const int n = m.num_nodes;
   const int ns = static_cast<int>(m.springs.rows());
   StepSprings& st = m.step_springs;
-  st.a.clear();
-  st.b.clear();
-  st.rest_length.clear();
-  st.stiffness.clear();
-  st.damping.clear();
   st.node_offset.assign(n + 1, 0);
+  int count = 0;
   for (int s = 0; s < ns; ++s) {
     const int a = m.springs(s, 0), b = m.springs(s, 1);
     if (m.fixed[a] && m.fixed[b]) continue;
-    st.a.push_back(a);
-    st.b.push_back(b);
-    st.rest_length.push_back(m.rest_length[s]);
-    st.stiffness.push_back(m.stiffness[s]);
-    st.damping.push_back(m.damping[s]);
+    ++count;
     ++st.node_offset[a + 1];
     ++st.node_offset[b + 1];
+  }
+  st.a.resize(count);
+  st.b.resize(count);
+  st.rest_length.resize(count);
+  st.stiffness.resize(count);
+  st.damping.resize(count);
+  for (int s = 0, k = 0; s < ns; ++s) {
+    const int a = m.springs(s, 0), b = m.springs(s, 1);
+    if (m.fixed[a] && m.fixed[b]) continue;
+    st.a[k] = a;
+    st.b[k] = b;
+    st.rest_length[k] = m.rest_length[s];
+    st.stiffness[k] = m.stiffness[s];
+    st.damping[k] = m.damping[s];
+    ++k;
   }
   for (int i = 0; i < n; ++i) st.node_offset[i + 1] += st.node_offset[i];
   st.incident.resize(st.node_offset[n]);
   st.sign.resize(st.node_offset[n]);
   std::vector<int> fill(st.node_offset.begin(), st.node_offset.end() - 1);
-  for (int k = 0; k < st.size(); ++k) {
-    st.incident[fill[st.a[k]]] = k;
-    st.sign[fill[st.a[k]]++] = 1.0;
-    st.incident[fill[st.b[k]]] = k;
-    st.sign[fill[st.b[k]]++] = -1.0;
+  for (int k = 0; k < count; ++k) {
+    const int a = st.a[k], b = st.b[k];
+    st.incident[fill[a]] = k;
+    st.sign[fill[a]++] = 1.0;
+    st.incident[fill[b]] = k;
+    st.sign[fill[b]++] = -1.0;
   }
 }
 

@@ -87,7 +87,10 @@ Result<Model> updateModel3D(const Model& before, const cutting::TetMesh& mesh_be
 //    when the previous estimate is not a Lanczos one (buildModel's power iteration, which
 //    approaches the top from below, too far to bound anything), a Lanczos estimate over all
 //    free nodes, started from the previous mode, replaces it. Selective mass scaling as buildModel, on the
-//    nodes of the estimate.
+//    nodes of the estimate. Near the cut, the Lanczos run is skipped when a cheap upper bound
+//    of the same top eigenvalue (max over the nodes of 2 lambda_max(sum_s k_s d_s d_s^T) / m_i)
+//    is below the previous estimate: a Lanczos estimate would be below it too, so the outcome
+//    (the previous estimate carried over) is the same.
 //  - the implicit integrator's factorisation is redone.
 struct CutUpdate3DOptions {
   MassUpdate3DOptions masses;
@@ -109,7 +112,7 @@ struct CutUpdate3DReport {
   int lanczos_steps = 0;
   bool global_stability = false;  // estimated over all free nodes (no previous estimate, or held too long)
   bool held_stability = false;    // the previous mode was near the cut: omega_max = max(local, previous)
-  double omega_local = 0.0;       // rad/s, estimate near the cut
+  double omega_local = 0.0;       // rad/s, estimate near the cut (or the upper bound that made it unneeded)
   double omega_previous = 0.0;    // rad/s
 };
 
