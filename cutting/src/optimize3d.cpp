@@ -1074,6 +1074,54 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   // the cut (its nearest point), and the tets that become flat (all four nodes on the cut) are
   // removed. Same acceptance as a collapse: nothing inverts, the worst q* around does not
   // fall, volume within the limits, no non-manifold node.
+  // Distances of nodes to the cut surface, kept with the position they were measured at
+  // (both snapNear calls ask about the same nodes; most have not moved in between). An entry
+  // is exact (|distance| and nearest point) or a lower bound (within() said no). within(x, r)
+  // is |signedDistance(x)| <= r with the same per-triangle distances, so the answers are the
+  // ones the surface queries give.
+  struct DistEntry {
+    Vec3 x;
+    double d;  // exact: |signed distance|; bound: the distance is above it
+    Vec3 closest;
+    std::int8_t kind = 0;  // 0 none, 1 exact, 2 lower bound
+  };
+  std::vector<std::int32_t> distSlot;
+  std::vector<DistEntry> distPool;
+  auto distEntry = [&](int n) -> DistEntry& {
+    if (distSlot.empty()) distSlot.assign(N, -1);
+    std::int32_t& slot = distSlot[n];
+    if (slot < 0) {
+      slot = static_cast<std::int32_t>(distPool.size());
+      distPool.emplace_back();
+    }
+    DistEntry& e = distPool[slot];
+    if (e.kind != 0 && e.x != pos(n)) e.kind = 0;
+    return e;
+  };
+  // |signed distance| of node n to the cut, and its nearest point.
+  auto nodeDistance = [&](int n, Vec3* closest) {
+    DistEntry& e = distEntry(n);
+    if (e.kind != 1) {
+      e.x = pos(n);
+      e.d = std::abs(region.surface->signedDistance(e.x, &e.closest));
+      e.kind = 1;
+    }
+    if (closest) *closest = e.closest;
+    return e.d;
+  };
+  // region.surface->within(pos(n), r).
+  auto nodeWithin = [&](int n, double r) {
+    DistEntry& e = distEntry(n);
+    if (e.kind == 1) return e.d <= r;
+    if (e.kind == 2 && r <= e.d) return false;
+    const bool in = region.surface->within(pos(n), r);
+    if (!in) {
+      e.x = pos(n);
+      e.d = r;
+      e.kind = 2;
+    }
+    return in;
+  };
   auto snapNear = [&]() {
     if (!(options.collapse_fraction > 0) || region.surface == nullptr) return;
     std::vector<std::pair<double, std::int32_t>> cands;
@@ -1086,8 +1134,8 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
         if (onCut[u] || tried[u]) continue;
         tried[u] = 1;
         const double limit = options.collapse_fraction * region.edge_length;
-        if (!region.surface->within(pos(u), limit)) continue;  // far: no nearest-point search
-        const double d = std::abs(region.surface->signedDistance(pos(u)));
+        if (!nodeWithin(u, limit)) continue;  // far: no nearest-point search
+        const double d = nodeDistance(u, nullptr);
         if (d < limit) cands.emplace_back(d, u);
       }
     std::sort(cands.begin(), cands.end());
@@ -1138,8 +1186,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       if (newMin < oldMin && worstTet >= 0) {
         for (int k = 0; k < 4; ++k) {
           const int v = mesh.T(worstTet, k);
-          if (!onCut[v] && !inGroup(v) && region.surface->within(pos(v), near) &&
-              std::abs(region.surface->signedDistance(pos(v))) < near)
+          if (!onCut[v] && !inGroup(v) && nodeWithin(v, near) && nodeDistance(v, nullptr) < near)
             *partner = v;
         }
       }
@@ -1185,7 +1232,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       // boundary's polygonal surface).
       targets.clear();
       targets.emplace_back();
-      region.surface->signedDistance(pos(u), &targets.back());
+      nodeDistance(u, &targets.back());
       for (const std::int32_t *s = starB(u), *sEnd = starE(u); s < sEnd; ++s) {
         const int t = (*s);
         if ((*dead)[t]) continue;
@@ -1215,7 +1262,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
           }
           if (partner < 0 || group.size() >= 3) break;
           Vec3 z;
-          region.surface->signedDistance(pos(partner), &z);
+          nodeDistance(partner, &z);
           group.push_back(partner);
           groupTo.push_back(z);
         }
@@ -1335,6 +1382,20 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       const Vec3 dirs[3] = {0.25 * h * grad, spring.norm() * unitIn(spring), 0.3 * h * push};
       double best = before, bestDv = 0;
       Vec3 bestX = x;
+      // Every candidate lies within 2 x the longest direction of x (a fan's nearest point is
+      // no farther from y than x is). When the cut surface is farther than that from x (with a
+      // margin of a few eps), no candidate can cross it or come within eps of it: sideKept
+      // holds for all of them, and its surface queries are skipped (one query, asked when the
+      // first candidate gets that far, instead).
+      int farFromCut = curved && !onCut[n] ? -1 : 0;  // -1: not asked yet
+      auto sideOk = [&](const Vec3& y) {
+        if (farFromCut < 0) {
+          double reach = 0;
+          for (const Vec3& d : dirs) reach = std::max(reach, d.norm());
+          farFromCut = nodeWithin(n, 2.0 * reach + 4.0 * region.eps) ? 0 : 1;
+        }
+        return farFromCut == 1 || sideKept(n, x, y);
+      };
       for (const Vec3& d : dirs) {
         if (d.squaredNorm() == 0) continue;
         double step = 1.0;
@@ -1375,7 +1436,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
           // The checks below must all pass and have no side effects: the cheapest first (the
           // worst tet, which starAbove tries first anyway), the surface queries after it.
           if (!(tetQAt(wt, n, y) > best)) continue;
-          if (!sideKept(n, x, y)) continue;
+          if (!sideOk(y)) continue;
           // Moves on a curved surface change the volume a little (the faces are chords): within the budget.
           double dv = 0;
           if (curved && (c.kind == Freedom::Surface || c.kind == Freedom::Fan || c.kind == Freedom::Ridge)) {
