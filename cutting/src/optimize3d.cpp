@@ -1316,6 +1316,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     if (n >= 0 && n < N) addBadAround(n, 0);
   std::vector<std::uint8_t> didMove(N, 0);
   std::vector<std::int32_t> movedNow;
+  std::vector<double> starVolume;  // per node in the move loop, filled when first needed
   int it = 0;
   for (; it < options.max_iterations && !work.empty(); ++it) {
     double largest = 0, scale = 0;
@@ -1388,6 +1389,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       // holds for all of them, and its surface queries are skipped (one query, asked when the
       // first candidate gets that far, instead).
       int farFromCut = curved && !onCut[n] ? -1 : 0;  // -1: not asked yet
+      starVolume.clear();
       auto sideOk = [&](const Vec3& y) {
         if (farFromCut < 0) {
           double reach = 0;
@@ -1440,11 +1442,15 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
           // Moves on a curved surface change the volume a little (the faces are chords): within the budget.
           double dv = 0;
           if (curved && (c.kind == Freedom::Surface || c.kind == Freedom::Fan || c.kind == Freedom::Ridge)) {
-            for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s) {
+            if (starVolume.empty())  // the star's volumes where n is (the same for every candidate)
+              for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s)
+                starVolume.push_back((*dead)[*s] ? 0.0 : tetVolume(mesh, *s));
+            const double* oldVolume = starVolume.data();
+            for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s, ++oldVolume) {
               if ((*dead)[*s]) continue;
               Vec3 p[4];
               for (int k = 0; k < 4; ++k) p[k] = mesh.T(*s, k) == n ? y : pos(mesh.T(*s, k));
-              dv += (p[1] - p[0]).dot((p[2] - p[0]).cross(p[3] - p[0])) / 6.0 - tetVolume(mesh, *s);
+              dv += (p[1] - p[0]).dot((p[2] - p[0]).cross(p[3] - p[0])) / 6.0 - *oldVolume;
             }
             if (!moveBudget.fits(dv) || std::abs(dv) > options.move_volume_fraction * edgeTet) continue;
           }
