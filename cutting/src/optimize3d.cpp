@@ -1388,6 +1388,12 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       // margin of a few eps), no candidate can cross it or come within eps of it: sideKept
       // holds for all of them, and its surface queries are skipped (one query, asked when the
       // first candidate gets that far, instead).
+      // y := its nearest point of the cut, which lies within |y - x| + dist(x) of y: the
+      // search looks no farther (the same point as a full search).
+      auto onCutAgain = [&](Vec3& y) {
+        const double r = (y - x).norm() + nodeDistance(n, nullptr);
+        region.surface->signedDistanceNear(Vec3(y), r, &y);
+      };
       int farFromCut = curved && !onCut[n] ? -1 : 0;  // -1: not asked yet
       starVolume.clear();
       auto sideOk = [&](const Vec3& y) {
@@ -1403,7 +1409,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
         double step = 1.0;
         for (int tries = 0; tries < 5; ++tries, step *= 0.5) {
           Vec3 y = x + step * d;
-          if (c.kind == Freedom::Surface) region.surface->signedDistance(Vec3(y), &y);
+          if (c.kind == Freedom::Surface) onCutAgain(y);
           if (c.kind == Freedom::Ridge) {  // along the ridge edge nearest the move, at most 0.45 of it
             const Vec3 d = y - x;
             double bestAlong = 0;
@@ -1420,7 +1426,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
             }
             if (!(bestAlong > 0)) continue;
             y = to;
-            if (onCut[n]) region.surface->signedDistance(Vec3(y), &y);
+            if (onCut[n]) onCutAgain(y);
           }
           if (c.kind == Freedom::Fan) {
             Vec3 best = y;
