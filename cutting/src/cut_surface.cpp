@@ -112,12 +112,20 @@ Eigen::Vector3d closestPointOnTriangle(const Eigen::Vector3d& p, const Eigen::Ve
 }
 
 double CutSurface::signedDistance(const Eigen::Vector3d& x, Eigen::Vector3d* closest) const {
+  return signedDistanceNear(x, std::numeric_limits<double>::infinity(), closest);
+}
+
+double CutSurface::signedDistanceNear(const Eigen::Vector3d& x, double r, Eigen::Vector3d* closest) const {
   if (is_plane_) {
     const double d = normal_.dot(x - point_);
     if (closest) *closest = x - d * normal_;
     return d;
   }
-  double best = std::numeric_limits<double>::infinity();
+  // Start with the bound r^2 (a margin for rounding) instead of infinity: boxes and triangles
+  // farther than r are skipped; the nearest triangle, within r, is found as before (ties: the
+  // lower index), so the result is the same.
+  double best = std::isfinite(r) ? r * r * (1.0 + 1e-6) + std::numeric_limits<double>::min()
+                                 : std::numeric_limits<double>::infinity();
   int bestTri = -1;
   Eigen::Vector3d bestPoint = x;
   int stack[128];
@@ -147,6 +155,7 @@ double CutSurface::signedDistance(const Eigen::Vector3d& x, Eigen::Vector3d* clo
       if (dNear <= best) stack[top++] = leftFirst ? node.left : node.right;
     }
   }
+  if (bestTri < 0 && std::isfinite(r)) return signedDistanceNear(x, std::numeric_limits<double>::infinity(), closest);
   if (closest) *closest = bestPoint;
   if (bestTri < 0) return std::numeric_limits<double>::infinity();
   const double d = std::sqrt(best);

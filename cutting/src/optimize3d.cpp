@@ -1095,6 +1095,54 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   // the cut (its nearest point), and the tets that become flat (all four nodes on the cut) are
   // removed. Same acceptance as a collapse: nothing inverts, the worst q* around does not
   // fall, volume within the limits, no non-manifold node.
+  // Distances of nodes to the cut surface, kept with the position they were measured at
+  // (both snapNear calls ask about the same nodes; most have not moved in between). An entry
+  // is exact (|distance| and nearest point) or a lower bound (within() said no). within(x, r)
+  // is |signedDistance(x)| <= r with the same per-triangle distances, so the answers are the
+  // ones the surface queries give.
+  struct DistEntry {
+    Vec3 x;
+    double d;  // exact: |signed distance|; bound: the distance is above it
+    Vec3 closest;
+    std::int8_t kind = 0;  // 0 none, 1 exact, 2 lower bound
+  };
+  std::vector<std::int32_t> distSlot;
+  std::vector<DistEntry> distPool;
+  auto distEntry = [&](int n) -> DistEntry& {
+    if (distSlot.empty()) distSlot.assign(N, -1);
+    std::int32_t& slot = distSlot[n];
+    if (slot < 0) {
+      slot = static_cast<std::int32_t>(distPool.size());
+      distPool.emplace_back();
+    }
+    DistEntry& e = distPool[slot];
+    if (e.kind != 0 && e.x != pos(n)) e.kind = 0;
+    return e;
+  };
+  // |signed distance| of node n to the cut, and its nearest point.
+  auto nodeDistance = [&](int n, Vec3* closest) {
+    DistEntry& e = distEntry(n);
+    if (e.kind != 1) {
+      e.x = pos(n);
+      e.d = std::abs(region.surface->signedDistance(e.x, &e.closest));
+      e.kind = 1;
+    }
+    if (closest) *closest = e.closest;
+    return e.d;
+  };
+  // region.surface->within(pos(n), r).
+  auto nodeWithin = [&](int n, double r) {
+    DistEntry& e = distEntry(n);
+    if (e.kind == 1) return e.d <= r;
+    if (e.kind == 2 && r <= e.d) return false;
+    const bool in = region.surface->within(pos(n), r);
+    if (!in) {
+      e.x = pos(n);
+      e.d = r;
+      e.kind = 2;
+    }
+    return in;
+  };
   auto snapNear = [&]() {
     if (!(options.collapse_fraction > 0) || region.surface == nullptr) return;
     std::vector<std::pair<double, std::int32_t>> cands;
@@ -1107,8 +1155,8 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
         if (onCut[u] || tried[u]) continue;
         tried[u] = 1;
         const double limit = options.collapse_fraction * region.edge_length;
-        if (!region.surface->within(pos(u), limit)) continue;  // far: no nearest-point search
-        const double d = std::abs(region.surface->signedDistance(pos(u)));
+        if (!nodeWithin(u, limit)) continue;  // far: no nearest-point search
+        const double d = nodeDistance(u, nullptr);
         if (d < limit) cands.emplace_back(d, u);
       }
     std::sort(cands.begin(), cands.end());
@@ -1159,8 +1207,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       if (newMin < oldMin && worstTet >= 0) {
         for (int k = 0; k < 4; ++k) {
           const int v = mesh.T(worstTet, k);
-          if (!onCut[v] && !inGroup(v) && region.surface->within(pos(v), near) &&
-              std::abs(region.surface->signedDistance(pos(v))) < near)
+          if (!onCut[v] && !inGroup(v) && nodeWithin(v, near) && nodeDistance(v, nullptr) < near)
             *partner = v;
         }
       }
@@ -1206,7 +1253,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       // boundary's polygonal surface).
       targets.clear();
       targets.emplace_back();
-      region.surface->signedDistance(pos(u), &targets.back());
+      nodeDistance(u, &targets.back());
       for (const std::int32_t *s = starB(u), *sEnd = starE(u); s < sEnd; ++s) {
         const int t = (*s);
         if ((*dead)[t]) continue;
@@ -1236,7 +1283,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
           }
           if (partner < 0 || group.size() >= 3) break;
           Vec3 z;
-          region.surface->signedDistance(pos(partner), &z);
+          nodeDistance(partner, &z);
           group.push_back(partner);
           groupTo.push_back(z);
         }
@@ -1290,6 +1337,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     if (n >= 0 && n < N) addBadAround(n, 0);
   std::vector<std::uint8_t> didMove(N, 0);
   std::vector<std::int32_t> movedNow;
+  std::vector<double> starVolume;  // per node in the move loop, filled when first needed
   int it = 0;
   for (; it < options.max_iterations && !work.empty(); ++it) {
     double largest = 0, scale = 0;
@@ -1356,12 +1404,33 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       const Vec3 dirs[3] = {0.25 * h * grad, spring.norm() * unitIn(spring), 0.3 * h * push};
       double best = before, bestDv = 0;
       Vec3 bestX = x;
+      // Every candidate lies within 2 x the longest direction of x (a fan's nearest point is
+      // no farther from y than x is). When the cut surface is farther than that from x (with a
+      // margin of a few eps), no candidate can cross it or come within eps of it: sideKept
+      // holds for all of them, and its surface queries are skipped (one query, asked when the
+      // first candidate gets that far, instead).
+      // y := its nearest point of the cut, which lies within |y - x| + dist(x) of y: the
+      // search looks no farther (the same point as a full search).
+      auto onCutAgain = [&](Vec3& y) {
+        const double r = (y - x).norm() + nodeDistance(n, nullptr);
+        region.surface->signedDistanceNear(Vec3(y), r, &y);
+      };
+      int farFromCut = curved && !onCut[n] ? -1 : 0;  // -1: not asked yet
+      starVolume.clear();
+      auto sideOk = [&](const Vec3& y) {
+        if (farFromCut < 0) {
+          double reach = 0;
+          for (const Vec3& d : dirs) reach = std::max(reach, d.norm());
+          farFromCut = nodeWithin(n, 2.0 * reach + 4.0 * region.eps) ? 0 : 1;
+        }
+        return farFromCut == 1 || sideKept(n, x, y);
+      };
       for (const Vec3& d : dirs) {
         if (d.squaredNorm() == 0) continue;
         double step = 1.0;
         for (int tries = 0; tries < 5; ++tries, step *= 0.5) {
           Vec3 y = x + step * d;
-          if (c.kind == Freedom::Surface) region.surface->signedDistance(Vec3(y), &y);
+          if (c.kind == Freedom::Surface) onCutAgain(y);
           if (c.kind == Freedom::Ridge) {  // along the ridge edge nearest the move, at most 0.45 of it
             const Vec3 d = y - x;
             double bestAlong = 0;
@@ -1378,7 +1447,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
             }
             if (!(bestAlong > 0)) continue;
             y = to;
-            if (onCut[n]) region.surface->signedDistance(Vec3(y), &y);
+            if (onCut[n]) onCutAgain(y);
           }
           if (c.kind == Freedom::Fan) {
             Vec3 best = y;
@@ -1396,15 +1465,19 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
           // The checks below must all pass and have no side effects: the cheapest first (the
           // worst tet, which starAbove tries first anyway), the surface queries after it.
           if (!(tetQAt(wt, n, y) > best)) continue;
-          if (!sideKept(n, x, y)) continue;
+          if (!sideOk(y)) continue;
           // Moves on a curved surface change the volume a little (the faces are chords): within the budget.
           double dv = 0;
           if (curved && (c.kind == Freedom::Surface || c.kind == Freedom::Fan || c.kind == Freedom::Ridge)) {
-            for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s) {
+            if (starVolume.empty())  // the star's volumes where n is (the same for every candidate)
+              for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s)
+                starVolume.push_back((*dead)[*s] ? 0.0 : tetVolume(mesh, *s));
+            const double* oldVolume = starVolume.data();
+            for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s, ++oldVolume) {
               if ((*dead)[*s]) continue;
               Vec3 p[4];
               for (int k = 0; k < 4; ++k) p[k] = mesh.T(*s, k) == n ? y : pos(mesh.T(*s, k));
-              dv += (p[1] - p[0]).dot((p[2] - p[0]).cross(p[3] - p[0])) / 6.0 - tetVolume(mesh, *s);
+              dv += (p[1] - p[0]).dot((p[2] - p[0]).cross(p[3] - p[0])) / 6.0 - *oldVolume;
             }
             if (!moveBudget.fits(dv) || std::abs(dv) > options.move_volume_fraction * edgeTet) continue;
           }

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <limits>
 #include <random>
 
 #include "box_mesh.hpp"
@@ -379,6 +380,34 @@ TEST(Cut3D, SurfaceWithinAndMayTouch) {
   const CutSurface p = *CutSurface::plane(Vec3(0, 0, 1), Vec3(0, 0, 1));
   EXPECT_TRUE(p.within(Vec3(3, 4, 1.2), 0.2 + 1e-12));
   EXPECT_FALSE(p.within(Vec3(3, 4, 0.7), 0.2));
+}
+
+// CutSurface::signedDistanceNear gives signedDistance's value and nearest point, bit for bit,
+// whatever the bound: a bound at or above the distance (the bounded search), below it (the
+// full search after all), or infinite.
+TEST(Cut3D, SurfaceSignedDistanceNearIsSignedDistance) {
+  const CutSurface s = cylinderStrip(Vec3(0.5, 0, 1.05), 0.5, M_PI * 0.95, M_PI * 2.05, -0.1, 1.1, 40, 4);
+  int bounded = 0;
+  for (int i = 0; i < 1000; ++i) {
+    const Vec3 x(-0.2 + 1.4 * std::fmod(i * 0.6180339887, 1.0), -0.3 + 1.6 * std::fmod(i * 0.7548776662, 1.0),
+                 0.3 + 1.0 * std::fmod(i * 0.5698402910, 1.0));
+    Vec3 c;
+    const double d = s.signedDistance(x, &c);
+    for (double r : {0.0, 0.5 * std::abs(d), std::abs(d), std::abs(d) + 1e-3, 2.0 * std::abs(d) + 0.1,
+                     std::numeric_limits<double>::infinity()}) {
+      Vec3 cn;
+      const double dn = s.signedDistanceNear(x, r, &cn);
+      EXPECT_EQ(dn, d) << x.transpose() << " r " << r;
+      EXPECT_EQ(cn, c) << x.transpose() << " r " << r;
+      bounded += r >= std::abs(d);
+    }
+  }
+  EXPECT_GT(bounded, 3000);
+  // Planes: the signed distance and the foot point, whatever r.
+  const CutSurface p = *CutSurface::plane(Vec3(0, 0, 1), Vec3(0, 0, 1));
+  Vec3 c;
+  EXPECT_DOUBLE_EQ(p.signedDistanceNear(Vec3(3, 4, 0.7), 0.01, &c), -0.3);
+  EXPECT_TRUE(c.isApprox(Vec3(3, 4, 1)));
 }
 
 TEST(Cut3D, PartialCutStaysConnectedAndValid) {

@@ -39,6 +39,10 @@ class CutSurface {
   // of that triangle's normal side (only meaningful close to the surface).
   // `closest` (optional) receives the nearest surface point.
   double signedDistance(const Eigen::Vector3d& x, Eigen::Vector3d* closest = nullptr) const;
+  // signedDistance(x, closest), the same value and point, for a point known to be within r of
+  // the surface: the search skips what lies farther than r (much cheaper near the surface).
+  // Where nothing is within r after all, the full search.
+  double signedDistanceNear(const Eigen::Vector3d& x, double r, Eigen::Vector3d* closest = nullptr) const;
 
   struct Hit {
     double t = 0;                 // a + t (b - a), 0 < t < 1
