@@ -545,36 +545,11 @@ void Simulation::finishPass() {
   const int kept = static_cast<int>(kept_rows.size());
   NearestPoint nearest_surface;  // built at the first point outside the tissue
   bool nearest_built = false;
-  // Most points lie a few tets from a neighbour's tet (the same wire point one row earlier,
-  // or the previous point of the row): a walk from there through face neighbours, each step
-  // across the face whose barycentric coordinate is most negative, finds a tet that holds p
-  // strictly inside (it gives up at the boundary, on a face, or after a few dozen steps).
-  // The grid query then looks only for lower-numbered tets that hold p too (deformed tets
-  // can overlap, and the grid's answer, the lowest-numbered, is the one kept), which most
-  // cells answer at once.
-  const bool can_walk = face_next_.size() == 4 * static_cast<size_t>(mesh_.numTets());
-  auto walk = [&](int t, const Eigen::Vector3d& p) {
-    if (t < 0 || !can_walk) return -1;
-    for (int steps = 0; steps < 48; ++steps) {
-      const Eigen::Vector4d w = barycentric(t, p);
-      if (!w.allFinite()) return -1;
-      Eigen::Index k = 0;
-      const double lowest = w.minCoeff(&k);
-      if (lowest > 1e-9) return t;
-      const int next = face_next_[4 * static_cast<size_t>(t) + static_cast<size_t>(k)];
-      if (next < 0 || lowest > -1e-9) return -1;  // at the boundary, or on a face
-      t = next / 4;
-    }
-    return -1;
-  };
-  std::vector<int> row_tets(static_cast<size_t>(row_size), -1);  // a tet near each wire point, last row
   cutting::Positions rv(static_cast<Eigen::Index>(kept) * row_size, 3);
   for (int r = 0; r < kept; ++r)
     for (int i = 0; i < row_size; ++i) {
       const Eigen::Vector3d p = sv.row(kept_rows[r] * row_size + i).transpose();
-      const int hint = row_tets[i] >= 0 ? row_tets[i] : (i > 0 ? row_tets[i - 1] : -1);
-      int t = locator_.locate(mesh_, state_.x, p, displacement, walk(hint, p));
-      row_tets[i] = t;
+      int t = locator_.locate(mesh_, state_.x, p, displacement);
       if (t < 0) {
         if (!nearest_built) {
           nearest_surface.build(state_.x, surface_nodes_);
@@ -586,7 +561,6 @@ void Simulation::finishPass() {
         const int nearest = nearest_surface.nearest(p);
         if (nearest < 0) return fail("no tissue to map the sweep to");
         t = node_tet[nearest];
-        row_tets[i] = t;  // a tet at the surface nearby: where the next row's walk starts
       }
       const Eigen::Vector4d w = barycentric(t, p);
       Eigen::RowVector3d q = Eigen::RowVector3d::Zero();

@@ -81,7 +81,7 @@ void TetLocator::build(const cutting::TetMesh& mesh, const sim::NodeVectors& x, 
 }
 
 int TetLocator::locate(const cutting::TetMesh& mesh, const sim::NodeVectors& x, const Eigen::Vector3d& p,
-                       double max_displacement, int known) const {
+                       double max_displacement) const {
   if (cell_start_.empty()) return -1;
   const double moved = max_displacement >= 0.0 ? max_displacement : margin_;
   // A tet that holds p now had a build box within `moved` of p (plus the tolerances below,
@@ -98,10 +98,6 @@ int TetLocator::locate(const cutting::TetMesh& mesh, const sim::NodeVectors& x, 
   // The lowest-numbered tet that holds p (a point on a shared face lies in several): the
   // same answer whichever cells list it.
   int best = -1;
-  if (known >= 0 && known < mesh.numTets() && 6 * static_cast<size_t>(known) < boxes_.size() &&
-      contains(mesh, x, known, p, moved)) {
-    best = known;
-  }
   for (int k = lo[2]; k <= hi[2]; ++k)
     for (int j = lo[1]; j <= hi[1]; ++j)
       for (int i = lo[0]; i <= hi[0]; ++i) {

@@ -21,11 +21,8 @@ class TetLocator {
   // Tet containing p at positions x, or -1. Allocates nothing. max_displacement: a bound on
   // how far the nodes moved since the build (maxDisplacement(x)), when the caller knows one
   // (the answer is the same, found faster); else the margin.
-  // known: a tet the caller found to hold p (e.g. by walking through face neighbours), or -1.
-  // When it holds p by this class's own test, only lower-numbered tets are looked at (a
-  // cell's scan stops at the first tet >= it): the answer is the same, found faster.
   int locate(const cutting::TetMesh& mesh, const sim::NodeVectors& x, const Eigen::Vector3d& p,
-             double max_displacement = -1.0, int known = -1) const;
+             double max_displacement = -1.0) const;
   // Largest node displacement since the build (O(#N)); rebuild when it exceeds margin().
   double maxDisplacement(const sim::NodeVectors& x) const;
   double margin() const { return margin_; }
