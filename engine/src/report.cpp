@@ -156,7 +156,8 @@ std::string reportJson(const RunReport& r) {
     e["cut_parts_ms"] = {{"map", p.map_ms},           {"cut3d", p.cut3d_ms},       {"remap", p.remap_ms},
                          {"components", p.components_ms}, {"model", p.model_ms},   {"surface", p.surface_ms},
                          {"collision", p.collision_ms}, {"locator", p.locator_ms}, {"chips", p.chips_ms},
-                         {"stats", p.stats_ms},         {"other", p.other_ms}};
+                         {"stats", p.stats_ms},         {"other", p.other_ms},
+                         {"geometry_wait", p.geometry_wait_ms}};
     e["chips"] = p.chips;
     e["removed_mm3"] = p.removed_mm3;
     e["removed_myoma_mm3"] = p.removed_myoma_mm3;

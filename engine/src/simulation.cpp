@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <thread>
 
 #include "hysim/cutting/cut3d.hpp"
 #include "hysim/engine/mesh_faces.hpp"
@@ -206,20 +207,26 @@ void Simulation::resetState(const sim::NodeVectors* x, const sim::NodeVectors* v
 }
 
 Status Simulation::rebuildGeometry(PassRecord* timing, const std::vector<std::uint8_t>* boundary) {
+  if (Status st = buildGeometry(mesh_, state_.x, timing, boundary); !st.ok()) return st;
+  finishGeometry(timing);
+  return Status::Ok();
+}
+
+Status Simulation::buildGeometry(const cutting::TetMesh& mesh, const sim::NodeVectors& x, PassRecord* timing,
+                                 const std::vector<std::uint8_t>* boundary) {
   PassTimer timer;
 
   // Surface for contact and rendering: boundary faces, compacted vertex numbering.
   Eigen::VectorXi face_tet;
-  if (boundary != nullptr && boundary->size() == 4 * static_cast<size_t>(mesh_.numTets())) {
-    boundaryFromSlots(mesh_, *boundary, surface_faces_, face_tet);
+  if (boundary != nullptr && boundary->size() == 4 * static_cast<size_t>(mesh.numTets())) {
+    boundaryFromSlots(mesh, *boundary, surface_faces_, face_tet);
   } else {
-    surface_faces_ = cutting::boundaryFaces(mesh_, &face_tet);
+    surface_faces_ = cutting::boundaryFaces(mesh, &face_tet);
   }
   surface_nodes_.clear();
   surface_triangles_.clear();
   surface_material_.clear();
-  contact_nodes_.clear();
-  std::vector<int> local(mesh_.numNodes(), -1);
+  std::vector<int> local(mesh.numNodes(), -1);
   // A surface vertex is drawn as myoma when all its boundary faces belong to myoma tets:
   // the rim where the myoma meets the wall keeps the endometrium colour, so the colour
   // blend happens on the myoma's side (its base is covered by endometrium in reality).
@@ -236,32 +243,40 @@ Status Simulation::rebuildGeometry(PassRecord* timing, const std::vector<std::ui
         surface_material_.push_back(render::SurfaceMaterial::Myoma);
       }
       surface_triangles_.push_back(static_cast<std::uint32_t>(local[node]));
-      if (mesh_.material[face_tet[f]] != myoma_label) {
+      if (mesh.material[face_tet[f]] != myoma_label) {
         surface_material_[local[node]] = render::SurfaceMaterial::Endometrium;
       }
     }
   }
-  if (on_cut_.size() != static_cast<size_t>(mesh_.numNodes())) on_cut_.assign(mesh_.numNodes(), 0);
-  for (size_t v = 0; v < surface_nodes_.size(); ++v) {
-    if (on_cut_[surface_nodes_[v]]) surface_material_[v] = render::SurfaceMaterial::Cut;
+  if (on_cut_.size() == static_cast<size_t>(mesh.numNodes())) {
+    for (size_t v = 0; v < surface_nodes_.size(); ++v) {
+      if (on_cut_[surface_nodes_[v]]) surface_material_[v] = render::SurfaceMaterial::Cut;
+    }
   }
+  timer.lap(timing ? &timing->surface_ms : nullptr);
+  // The boundary's hierarchy, with boxes grown by half a millimetre: while the tissue near
+  // the loop moves less than that, a step only moves the vertices (see collision.hpp).
+  if (Status st = collision_.build(surface_faces_, x, 0.5); !st.ok()) return st;
+  timer.lap(timing ? &timing->collision_ms : nullptr);
+  locator_.build(mesh, x);
+  timer.lap(timing ? &timing->locator_ms : nullptr);
+  return Status::Ok();
+}
+
+void Simulation::finishGeometry(PassRecord* timing) {
+  PassTimer timer;
+  if (on_cut_.size() != static_cast<size_t>(mesh_.numNodes())) on_cut_.assign(mesh_.numNodes(), 0);
+  contact_nodes_.clear();
   for (int node : surface_nodes_) {
     if (!model_.fixed[node]) contact_nodes_.push_back(node);
   }
   contact_force_ = sim::NodeVectors::Zero(mesh_.numNodes(), 3);
-  timer.lap(timing ? &timing->surface_ms : nullptr);
-  // The boundary's hierarchy, with boxes grown by half a millimetre: while the tissue near
-  // the loop moves less than that, a step only moves the vertices (see collision.hpp).
-  if (Status st = collision_.build(surface_faces_, state_.x, 0.5); !st.ok()) return st;
   collision_active_ = true;  // just fitted
   buried_known_ = false;
-  timer.lap(timing ? &timing->collision_ms : nullptr);
-  locator_.build(mesh_, state_.x);
-  timer.lap(timing ? &timing->locator_ms : nullptr);
+  timer.lap(timing ? &timing->surface_ms : nullptr);
   if (chips_) chips_->setCavity(state_.x, surface_faces_);
   timer.lap(timing ? &timing->chips_ms : nullptr);
   ++topology_version_;
-  return Status::Ok();
 }
 
 Result<std::unique_ptr<Simulation>> Simulation::create(const Scene& scene) {
@@ -735,10 +750,23 @@ void Simulation::finishPass() {
   timer.lap(&rec.chips_ms);
   // The tissue model, updated around the cut (moment-preserving masses, Van Gelder springs,
   // stability estimate near the cut); the chips leave with their masses.
+  // Meanwhile a second thread builds the kept mesh's boundary, render surface, FCL hierarchy
+  // and tet locator (buildGeometry): they depend on the kept mesh and positions only, the
+  // model update on neither, and each writes its own members, so the result is the same as
+  // one after the other.
+  Status geometry;
+  std::thread geometry_thread([&] {
+    geometry = buildGeometry(rest_mesh, x_kept, &rec, kept_boundary.empty() ? nullptr : &kept_boundary);
+  });
   sim::CutUpdate3DReport update;
-  if (Status st = sim::updateModelAfterCut3D(model_, mesh_, after, change, anchored_after, new_index, {}, &update);
-      !st.ok()) {
-    return fail(st.error());
+  const Status model_status =
+      sim::updateModelAfterCut3D(model_, mesh_, after, change, anchored_after, new_index, {}, &update);
+  timer.lap(&rec.model_ms);
+  geometry_thread.join();
+  timer.lap(&rec.geometry_wait_ms);
+  if (!model_status.ok() || !geometry.ok()) {  // not reached for a valid mesh
+    (void)rebuildGeometry(nullptr);            // the hierarchy and locator of mesh_ again
+    return fail(!model_status.ok() ? model_status.error() : geometry.error());
   }
   const cutting::TetMesh previous = std::move(mesh_);
   mesh_ = std::move(rest_mesh);
@@ -748,9 +776,7 @@ void Simulation::finishPass() {
   rec.stability_nodes = update.stability_nodes;
   rec.global_stability = update.global_stability;
   timer.lap(&rec.model_ms);
-  if (Status st = rebuildGeometry(&rec, kept_boundary.empty() ? nullptr : &kept_boundary); !st.ok()) {
-    return fail(st.error());
-  }
+  finishGeometry(&rec);
   timer.lap(nullptr);
   for (const ChipShape& chip : chip_shapes) chips_->addChip(chip);  // after the cavity is rebuilt
   timer.lap(&rec.chips_ms);
@@ -786,8 +812,7 @@ void Simulation::finishPass() {
   rec.added_mass_g = model_.added_mass;
   rec.cut_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
   rec.other_ms = std::max(0.0, rec.cut_ms - (rec.map_ms + rec.cut3d_ms + rec.remap_ms + rec.components_ms + rec.model_ms +
-                                             rec.surface_ms + rec.collision_ms + rec.locator_ms + rec.chips_ms +
-                                             rec.stats_ms));
+                                             rec.geometry_wait_ms + rec.chips_ms + rec.stats_ms));
   passes_.push_back(rec);
 }
 

@@ -31,9 +31,14 @@ struct PassRecord {
   // cutting::cut3d, current positions of the cut mesh, free pieces found and removed (mesh
   // compacted), the tissue model (masses, springs, stability), boundary/render/contact
   // arrays, the FCL hierarchy, the tet locator, chip shapes and bodies, mesh statistics;
-  // other_ms is what is left (cut_ms minus the parts).
+  // other_ms is what is left (cut_ms minus the parts). In a pass the boundary, FCL hierarchy
+  // and locator (surface_ms, collision_ms, locator_ms: that thread's wall time) are built on a
+  // second thread while this one updates the model (model_ms); geometry_wait_ms is how long
+  // this thread then waited for them (what they add to cut_ms), and other_ms is computed
+  // with geometry_wait_ms in place of those three.
   double map_ms = 0.0, cut3d_ms = 0.0, remap_ms = 0.0, components_ms = 0.0, model_ms = 0.0, surface_ms = 0.0,
-         collision_ms = 0.0, locator_ms = 0.0, chips_ms = 0.0, stats_ms = 0.0, other_ms = 0.0;
+         collision_ms = 0.0, locator_ms = 0.0, chips_ms = 0.0, stats_ms = 0.0, other_ms = 0.0,
+         geometry_wait_ms = 0.0;
   int chips = 0;             // free pieces removed
   double removed_mm3 = 0.0;  // volume of the removed chips
   double removed_myoma_mm3 = 0.0;
@@ -134,6 +139,15 @@ class Simulation {
   // `boundary` (optional, 4 #T): which tet faces (slot 4 t + k, face k opposite vertex k) lie
   // on the boundary, when the caller knows; else they are found from mesh_.
   Status rebuildGeometry(PassRecord* timing, const std::vector<std::uint8_t>* boundary = nullptr);
+  // rebuildGeometry's first part, for `mesh` at positions x (the next mesh_ and state_.x): the
+  // boundary faces, render surface, FCL hierarchy and tet locator. It writes only those
+  // members (surface_*, collision_, locator_) and reads on_cut_ and scene_, so a pass runs it
+  // on a second thread beside the model update. Times surface_ms, collision_ms, locator_ms.
+  Status buildGeometry(const cutting::TetMesh& mesh, const sim::NodeVectors& x, PassRecord* timing,
+                       const std::vector<std::uint8_t>* boundary);
+  // rebuildGeometry's second part, once mesh_, model_ and state_ are the new ones: contact
+  // nodes and forces, collision flags, chips' cavity, topology version.
+  void finishGeometry(PassRecord* timing);
   // State for model_ and mesh_ with positions x and velocities v (null: rest, zero), keeping
   // the step count, time and warnings; counts anchored and deformable elements.
   void resetState(const sim::NodeVectors* x, const sim::NodeVectors* v);
