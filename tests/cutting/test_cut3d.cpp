@@ -348,15 +348,19 @@ TEST(Cut3D, CurvedSurfaceFullCutSeparatesPiece) {
   }
 }
 
+// Point i of a deterministic low-discrepancy set over the test strip's box and around it.
+Vec3 pointAroundStrip(int i) {
+  return Vec3(-0.2 + 1.4 * std::fmod(i * 0.6180339887, 1.0), -0.3 + 1.6 * std::fmod(i * 0.7548776662, 1.0),
+              0.3 + 1.0 * std::fmod(i * 0.5698402910, 1.0));
+}
+
 // CutSurface::within answers |signedDistance| <= r; mayTouch rules out boxes that meet the
 // surface's bounding box but no part of the surface (the inside of a curved strip).
 TEST(Cut3D, SurfaceWithinAndMayTouch) {
   const CutSurface s = cylinderStrip(Vec3(0.5, 0, 1.05), 0.5, M_PI * 0.95, M_PI * 2.05, -0.1, 1.1, 40, 4);
   int near = 0;
   for (int i = 0; i < 2000; ++i) {
-    // Deterministic points over the strip's box and around it.
-    const Vec3 x(-0.2 + 1.4 * std::fmod(i * 0.6180339887, 1.0), -0.3 + 1.6 * std::fmod(i * 0.7548776662, 1.0),
-                 0.3 + 1.0 * std::fmod(i * 0.5698402910, 1.0));
+    const Vec3 x = pointAroundStrip(i);
     for (double r : {1e-3, 0.05, 0.3}) {
       const bool expect = std::abs(s.signedDistance(x)) <= r;
       EXPECT_EQ(s.within(x, r), expect) << x.transpose() << " r " << r;
@@ -389,8 +393,7 @@ TEST(Cut3D, SurfaceSignedDistanceNearIsSignedDistance) {
   const CutSurface s = cylinderStrip(Vec3(0.5, 0, 1.05), 0.5, M_PI * 0.95, M_PI * 2.05, -0.1, 1.1, 40, 4);
   int bounded = 0;
   for (int i = 0; i < 1000; ++i) {
-    const Vec3 x(-0.2 + 1.4 * std::fmod(i * 0.6180339887, 1.0), -0.3 + 1.6 * std::fmod(i * 0.7548776662, 1.0),
-                 0.3 + 1.0 * std::fmod(i * 0.5698402910, 1.0));
+    const Vec3 x = pointAroundStrip(i);
     Vec3 c;
     const double d = s.signedDistance(x, &c);
     for (double r : {0.0, 0.5 * std::abs(d), std::abs(d), std::abs(d) + 1e-3, 2.0 * std::abs(d) + 0.1,
