@@ -29,7 +29,7 @@
 //  - the group is no bridge between two large parts: the tets next to it stay connected
 //    (walks of at most 256 tets); a closed piece that hung on the group only (a chip the
 //    sweep almost cut off, held by a neck this thin) is freed, as the cut frees chips.
-// Local: one O(#T) node -> tet pass; the rest touches only the tets around the seeds.
+// Local: it works on the optimiser's node -> tet lists and touches only the tets around the seeds.
 #include "flap_peel.hpp"
 
 #include <algorithm>
@@ -116,7 +116,8 @@ StarShape starShape(const TetMesh& mesh, int v, const std::vector<std::int32_t>&
 }
 
 void peelFlaps(const TetMesh& mesh, const CutRegion& region, const std::vector<std::int32_t>& seeds,
-               const Optimize3DOptions& options, std::vector<std::uint8_t>* dead, OptimizeCounts* counts) {
+               const NodeStars& stars, const Optimize3DOptions& options, std::vector<std::uint8_t>* dead,
+               OptimizeCounts* counts) {
   const int N = mesh.numNodes(), M = mesh.numTets();
   if (!(options.flap_quality > 0) || seeds.empty() || N == 0 || !(region.edge_length > 0)) return;
   const double edgeTet = region.edge_length * region.edge_length * region.edge_length / (6.0 * std::sqrt(2.0));
@@ -125,19 +126,6 @@ void peelFlaps(const TetMesh& mesh, const CutRegion& region, const std::vector<s
   if (!(groupLimit > 0) || !(passLeft > 0)) return;
   std::vector<std::uint8_t>& gone = *dead;
 
-  // Node -> live tets (CSR, one pass over the tets).
-  std::vector<std::int32_t> off(N + 1, 0), star;
-  for (int t = 0; t < M; ++t)
-    if (!gone[t])
-      for (int k = 0; k < 4; ++k) ++off[mesh.T(t, k) + 1];
-  for (int i = 0; i < N; ++i) off[i + 1] += off[i];
-  star.resize(off[N]);
-  {
-    std::vector<std::int32_t> fill(off.begin(), off.end() - 1);
-    for (int t = 0; t < M; ++t)
-      if (!gone[t])
-        for (int k = 0; k < 4; ++k) star[fill[mesh.T(t, k)]++] = t;
-  }
   auto pos = [&](int n) { return Vec3(mesh.X.row(n).transpose()); };
   auto volume = [&](int t) {
     const Vec3 a = pos(mesh.T(t, 0));
@@ -149,8 +137,8 @@ void peelFlaps(const TetMesh& mesh, const CutRegion& region, const std::vector<s
   // The live tet other than t across face f of t, or -1 (a boundary face).
   auto across = [&](int t, int f) {
     const int a = mesh.T(t, kFace[f][0]), b = mesh.T(t, kFace[f][1]), c = mesh.T(t, kFace[f][2]);
-    for (int s = off[a]; s < off[a + 1]; ++s) {
-      const int u = star[s];
+    for (const std::int32_t *s = stars.begin(a), *sEnd = stars.end(a); s < sEnd; ++s) {
+      const int u = *s;
       if (u != t && !gone[u] && has(u, b) && has(u, c)) return u;
     }
     return -1;
@@ -167,7 +155,7 @@ void peelFlaps(const TetMesh& mesh, const CutRegion& region, const std::vector<s
     }
   // Nodes on the cut that the cut did not touch (it passed within eps of them) are seeds too.
   for (int n = 0; n < N && n < static_cast<int>(region.on_cut.size()); ++n)
-    if (region.on_cut[n] && ring[n] < 0 && off[n + 1] > off[n]) {
+    if (region.on_cut[n] && ring[n] < 0 && stars.end(n) > stars.begin(n)) {
       ring[n] = 0;
       frontier.push_back(n);
       nearNodes.push_back(n);
@@ -175,9 +163,9 @@ void peelFlaps(const TetMesh& mesh, const CutRegion& region, const std::vector<s
   for (int r = 1; r <= options.flap_rings && !frontier.empty(); ++r) {
     next.clear();
     for (int n : frontier)
-      for (int s = off[n]; s < off[n + 1]; ++s)
+      for (const std::int32_t *s = stars.begin(n), *sEnd = stars.end(n); s < sEnd; ++s)
         for (int k = 0; k < 4; ++k) {
-          const int v = mesh.T(star[s], k);
+          const int v = mesh.T(*s, k);
           if (ring[v] < 0) {
             ring[v] = static_cast<std::int8_t>(r);
             next.push_back(v);
@@ -191,7 +179,7 @@ void peelFlaps(const TetMesh& mesh, const CutRegion& region, const std::vector<s
   std::vector<std::int32_t> cands;
   std::vector<double> candQ;
   for (int n : nearNodes)
-    for (int s = off[n]; s < off[n + 1]; ++s) cands.push_back(star[s]);
+    cands.insert(cands.end(), stars.begin(n), stars.end(n));
   std::sort(cands.begin(), cands.end());
   cands.erase(std::unique(cands.begin(), cands.end()), cands.end());
   {
@@ -235,8 +223,8 @@ void peelFlaps(const TetMesh& mesh, const CutRegion& region, const std::vector<s
   std::vector<std::int32_t> around;
   auto liveStar = [&](int v) {
     around.clear();
-    for (int s = off[v]; s < off[v + 1]; ++s)
-      if (!gone[star[s]]) around.push_back(star[s]);
+    for (const std::int32_t *s = stars.begin(v), *sEnd = stars.end(v); s < sEnd; ++s)
+      if (!gone[*s]) around.push_back(*s);
   };
   // Pieces of v's live star (connected through faces with v) into pieceOf (index in
   // `around`); returns the number of pieces, or -1 if a face is used more than twice or the
@@ -314,8 +302,8 @@ void peelFlaps(const TetMesh& mesh, const CutRegion& region, const std::vector<s
   // The tet across face f of t among the live tets and the group's, or -1.
   auto acrossWithGroup = [&](int t, int f) {
     const int a = mesh.T(t, kFace[f][0]), b = mesh.T(t, kFace[f][1]), c = mesh.T(t, kFace[f][2]);
-    for (int s = off[a]; s < off[a + 1]; ++s) {
-      const int u = star[s];
+    for (const std::int32_t *s = stars.begin(a), *sEnd = stars.end(a); s < sEnd; ++s) {
+      const int u = *s;
       if (u != t && (!gone[u] || inGroup(u)) && has(u, b) && has(u, c)) return u;
     }
     return -1;

@@ -92,12 +92,9 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   std::vector<std::uint8_t> touched(N, 0);
   std::vector<std::int32_t> touchedList;
   std::vector<std::pair<std::int32_t, std::int32_t>> gained;  // (node, tet): tet took the node
-  auto starB = [&](int n) -> const std::int32_t* {
-    return ovrStart[n] >= 0 ? ovrPool.data() + ovrStart[n] : star.data() + off[n];
-  };
-  auto starE = [&](int n) -> const std::int32_t* {
-    return ovrStart[n] >= 0 ? ovrPool.data() + ovrStart[n] + ovrLen[n] : star.data() + off[n + 1];
-  };
+  const NodeStars stars{off, star, ovrStart, ovrLen, ovrPool};
+  auto starB = [&](int n) { return stars.begin(n); };
+  auto starE = [&](int n) { return stars.end(n); };
   auto touch = [&](int n) {
     if (!touched[n]) {
       touched[n] = 1;
@@ -1516,7 +1513,8 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   if (moved) moved->insert(moved->end(), lateSnapped.begin(), lateSnapped.end());
   if (counts) counts->onto_cut = lateSnapped;
   if (curved) {
-    peelFlaps(mesh, region, seeds, options, dead, counts);  // flap_peel.cpp
+    buildStars();  // the lists of the nodes around tets peeled above, as peelFlaps needs them
+    peelFlaps(mesh, region, seeds, stars, options, dead, counts);  // flap_peel.cpp
     // Tets below flap_quality that no repair removed, around a node earlier cuts left
     // non-manifold (every collapse there was refused): collapse their edges, the node
     // staying as it was.
