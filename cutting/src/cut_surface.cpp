@@ -21,6 +21,7 @@ Result<CutSurface> CutSurface::plane(const Eigen::Vector3d& point, const Eigen::
 Result<CutSurface> CutSurface::triangles(const Positions& X, const Tris& F) {
   CutSurface s;
   s.is_plane_ = false;
+  s.tri_.reserve(static_cast<size_t>(F.rows()));
   for (Eigen::Index f = 0; f < F.rows(); ++f) {
     for (int k = 0; k < 3; ++k)
       if (F(f, k) < 0 || F(f, k) >= X.rows())
@@ -38,39 +39,70 @@ Result<CutSurface> CutSurface::triangles(const Positions& X, const Tris& F) {
     s.tri_.push_back(t);
   }
   if (s.tri_.empty()) return Error{"cut surface: no non-degenerate triangle"};
-  s.order_.resize(s.tri_.size());
-  for (size_t i = 0; i < s.order_.size(); ++i) s.order_[i] = static_cast<int>(i);
+  const int count = static_cast<int>(s.tri_.size());
+  s.order_.resize(count);
+  for (int i = 0; i < count; ++i) s.order_[i] = i;
+  // Per triangle, once: its box, a + b + c (the split key) and its centroid (a + b + c) / 3,
+  // the same values the tree build used to recompute at every level.
+  BuildScratch scratch;
+  scratch.lo.resize(count);
+  scratch.hi.resize(count);
+  scratch.sum.resize(count);
+  scratch.centre.resize(count);
+  for (int i = 0; i < count; ++i) {
+    const Tri& t = s.tri_[i];
+    scratch.lo[i] = t.a.cwiseMin(t.b).cwiseMin(t.c);
+    scratch.hi[i] = t.a.cwiseMax(t.b).cwiseMax(t.c);
+    scratch.sum[i] = t.a + t.b + t.c;
+    scratch.centre[i] = scratch.sum[i] / 3.0;
+  }
   s.nodes_.reserve(2 * s.tri_.size());
-  s.build(0, static_cast<int>(s.tri_.size()));
+  s.build(0, count, scratch);
   s.bounds_ = s.nodes_[0].box;
+  // The triangles in tree order (leaf ranges contiguous), with what the segment test needs.
+  s.leafTri_.reserve(count);
+  for (int i = 0; i < count; ++i) {
+    const Tri& t = s.tri_[s.order_[i]];
+    s.leafTri_.push_back({t, t.n.dot((t.b - t.a).cross(t.c - t.a))});
+  }
   return s;
 }
 
-int CutSurface::build(int begin, int end) {
+int CutSurface::build(int begin, int end, const BuildScratch& scratch) {
   const int id = static_cast<int>(nodes_.size());
   nodes_.emplace_back();
-  Eigen::AlignedBox3d box, centres;
-  for (int i = begin; i < end; ++i) {
-    const Tri& t = tri_[order_[i]];
-    box.extend(t.a).extend(t.b).extend(t.c);
-    centres.extend((t.a + t.b + t.c) / 3.0);
-  }
-  nodes_[id].box = box;
   if (end - begin <= 4) {
+    // A leaf: the box of its triangles (min/max: the same values in any order of extension).
+    Eigen::Vector3d lo = scratch.lo[order_[begin]], hi = scratch.hi[order_[begin]];
+    for (int i = begin + 1; i < end; ++i) {
+      lo = lo.cwiseMin(scratch.lo[order_[i]]);
+      hi = hi.cwiseMax(scratch.hi[order_[i]]);
+    }
+    nodes_[id].box = Eigen::AlignedBox3d(lo, hi);
     nodes_[id].begin = begin;
     nodes_[id].end = end;
     return id;
   }
+  // Split at the median centroid along the longest axis of the centroids' box.
+  Eigen::Vector3d clo = scratch.centre[order_[begin]], chi = clo;
+  for (int i = begin + 1; i < end; ++i) {
+    const Eigen::Vector3d& c = scratch.centre[order_[i]];
+    clo = clo.cwiseMin(c);
+    chi = chi.cwiseMax(c);
+  }
   int axis;
-  centres.sizes().maxCoeff(&axis);
+  (chi - clo).maxCoeff(&axis);
   const int mid = (begin + end) / 2;
-  std::nth_element(order_.begin() + begin, order_.begin() + mid, order_.begin() + end, [&](int x, int y) {
-    return tri_[x].a[axis] + tri_[x].b[axis] + tri_[x].c[axis] < tri_[y].a[axis] + tri_[y].b[axis] + tri_[y].c[axis];
-  });
-  const int left = build(begin, mid);
-  const int right = build(mid, end);
+  const Eigen::Vector3d* sum = scratch.sum.data();
+  std::nth_element(order_.begin() + begin, order_.begin() + mid, order_.begin() + end,
+                   [sum, axis](int x, int y) { return sum[x][axis] < sum[y][axis]; });
+  const int left = build(begin, mid, scratch);
+  const int right = build(mid, end, scratch);
   nodes_[id].left = left;
   nodes_[id].right = right;
+  // The box of the children's boxes: that of all the range's triangles.
+  nodes_[id].box = Eigen::AlignedBox3d(nodes_[left].box.min().cwiseMin(nodes_[right].box.min()),
+                                       nodes_[left].box.max().cwiseMax(nodes_[right].box.max()));
   return id;
 }
 
@@ -86,6 +118,11 @@ inline double boxDistance2(const Eigen::AlignedBox3d& box, const Eigen::Vector3d
     dist2 += aux * aux;
   }
   return dist2;
+}
+// AlignedBox::intersects for two non-empty boxes (min <= max on every axis).
+inline bool boxesMeet(const Eigen::AlignedBox3d& box, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
+  return box.min()[0] <= hi[0] && lo[0] <= box.max()[0] && box.min()[1] <= hi[1] && lo[1] <= box.max()[1] &&
+         box.min()[2] <= hi[2] && lo[2] <= box.max()[2];
 }
 }  // namespace
 
@@ -136,7 +173,7 @@ double CutSurface::signedDistanceNear(const Eigen::Vector3d& x, double r, Eigen:
     if (boxDistance2(node.box, x) > best) continue;  // (equal: a tie with a lower index may be there)
     if (node.left < 0) {
       for (int i = node.begin; i < node.end; ++i) {
-        const Tri& t = tri_[order_[i]];
+        const Tri& t = leafTri_[i].t;
         const Eigen::Vector3d q = closestPointOnTriangle(x, t.a, t.b, t.c);
         const double d2 = (q - x).squaredNorm();
         // (Ties: the lower triangle index, whatever the order of the walk.)
@@ -180,8 +217,7 @@ bool CutSurface::intersectSegment(const Eigen::Vector3d& a, const Eigen::Vector3
     hit->db = db;
     return true;
   }
-  Eigen::AlignedBox3d seg;
-  seg.extend(a).extend(b);
+  const Eigen::Vector3d segLo = a.cwiseMin(b), segHi = a.cwiseMax(b);
   bool found = false;
   double bestT = 2.0;
   int stack[128];
@@ -189,15 +225,15 @@ bool CutSurface::intersectSegment(const Eigen::Vector3d& a, const Eigen::Vector3
   stack[top++] = 0;
   while (top > 0) {
     const Node& node = nodes_[stack[--top]];
-    if (!node.box.intersects(seg)) continue;
+    if (!boxesMeet(node.box, segLo, segHi)) continue;
     if (node.left < 0) {
       for (int i = node.begin; i < node.end; ++i) {
-        const Tri& tr = tri_[order_[i]];
+        const Tri& tr = leafTri_[i].t;
         double t, da, db;
         if (!tryPlane(tr.n, tr.a, &t, &da, &db) || t >= bestT) continue;
         const Eigen::Vector3d p = a + t * (b - a);
         // Inclusive inside test by signed sub-triangle areas along the normal.
-        const double area = tr.n.dot((tr.b - tr.a).cross(tr.c - tr.a));
+        const double area = leafTri_[i].area;
         const double slack = -1e-12 * area;
         const double w0 = tr.n.dot((tr.b - p).cross(tr.c - p));
         const double w1 = tr.n.dot((tr.c - p).cross(tr.a - p));
@@ -226,16 +262,16 @@ bool CutSurface::mayTouch(const Eigen::AlignedBox3d& box, double eps) const {
     const double r = std::abs(normal_.x()) * h.x() + std::abs(normal_.y()) * h.y() + std::abs(normal_.z()) * h.z();
     return std::abs(normal_.dot(c - point_)) <= r + eps;
   }
-  Eigen::AlignedBox3d grown = box;
-  grown.min().array() -= eps;
-  grown.max().array() += eps;
+  Eigen::Vector3d grownLo = box.min(), grownHi = box.max();
+  grownLo.array() -= eps;
+  grownHi.array() += eps;
   // Down the tree: the box meets a leaf's box (a few triangles).
   int stack[128];
   int top = 0;
   stack[top++] = 0;
   while (top > 0) {
     const Node& node = nodes_[stack[--top]];
-    if (!node.box.intersects(grown)) continue;
+    if (!boxesMeet(node.box, grownLo, grownHi)) continue;
     if (node.left < 0 || top + 2 > 128) return true;
     stack[top++] = node.left;
     stack[top++] = node.right;
@@ -255,7 +291,7 @@ bool CutSurface::within(const Eigen::Vector3d& x, double r) const {
     if (boxDistance2(node.box, x) > limit) continue;
     if (node.left < 0) {
       for (int i = node.begin; i < node.end; ++i) {
-        const Tri& t = tri_[order_[i]];
+        const Tri& t = leafTri_[i].t;
         if (std::sqrt((closestPointOnTriangle(x, t.a, t.b, t.c) - x).squaredNorm()) <= r) return true;
       }
     } else if (top + 2 <= 128) {

@@ -72,13 +72,21 @@ class CutSurface {
     int left = -1, right = -1;   // children; leaf when left < 0
     int begin = 0, end = 0;      // leaf: range in order_
   };
-  int build(int begin, int end);
+  struct LeafTri {
+    Tri t;
+    double area;  // t.n . ((b - a) x (c - a)), for the inside test of intersectSegment
+  };
+  struct BuildScratch {
+    std::vector<Eigen::Vector3d> lo, hi, sum, centre;  // per triangle: box, a + b + c, centroid
+  };
+  int build(int begin, int end, const BuildScratch& scratch);
 
   bool is_plane_ = true;
   Eigen::Vector3d point_ = Eigen::Vector3d::Zero(), normal_ = Eigen::Vector3d::UnitZ();
   std::vector<Tri> tri_;
   std::vector<int> order_;
   std::vector<Node> nodes_;
+  std::vector<LeafTri> leafTri_;  // tri_[order_[i]] at i (the leaves' ranges contiguous)
   Eigen::AlignedBox3d bounds_;
 };
 
