@@ -501,7 +501,9 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
   };
   std::vector<Seen> seenFaces;
   std::vector<std::int32_t> bfNbrs, bfLocal(N0, -1), faceAt;
-  auto boundaryFacesOf = [&](int n) {
+  // The faces go to `out` (cleared first): scratch vectors owned by the callers, so that no
+  // call allocates once they have grown.
+  auto boundaryFacesOf = [&](int n, std::vector<BFace>& out) {
     if (bfStart[n] < 0 && evenFacePairs(w, n, starOff, starTet)) {
       bfStart[n] = static_cast<std::int32_t>(bfPool.size());  // interior: no boundary face
       bfCount[n] = 0;
@@ -548,14 +550,20 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
         if (q.count == 1) bfPool.push_back({q.i0, q.i1, q.i2, q.u, q.v});
       bfCount[n] = static_cast<std::int32_t>(bfPool.size()) - bfStart[n];
     }
-    std::vector<BFace> out;
-    out.reserve(bfCount[n]);
+    out.clear();
     for (int q = bfStart[n]; q < bfStart[n] + bfCount[n]; ++q) {
       const BFaceTopo& f = bfPool[q];
       out.push_back({f.u, f.v, Vec3((w.x(f.i1) - w.x(f.i0)).cross(w.x(f.i2) - w.x(f.i0))).normalized()});
     }
-    return out;
   };
+  std::vector<BFace> candBf, feBf, feBfM;  // scratch: the callers below, featureEdgesOf
+  // featureEdgesOf: boundary edges of n (by their other node) with the count of their
+  // boundary faces around n and the first two faces' normals.
+  struct FeEdge {
+    std::int32_t v, count;
+    Vec3 normal[2];
+  };
+  std::vector<FeEdge> feEdges;
   // Feature edges of a boundary node: boundary edges whose two faces meet at more than the
   // feature angle. `straight`: exactly two, nearly straight through n (a ridge node); a node
   // may slide along its feature edges and stays on the feature lines (a corner or a bent
@@ -567,23 +575,25 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
   };
   auto featureEdgesOf = [&](int n) {
     FeatureEdges fe;
-    const auto bf = boundaryFacesOf(n);
-    std::vector<std::pair<std::int32_t, std::vector<Vec3>>> edges;
+    boundaryFacesOf(n, feBf);
+    const std::vector<BFace>& bf = feBf;
+    feEdges.clear();
     auto add = [&](std::int32_t v, const Vec3& nrm) {
-      for (auto& e : edges)
-        if (e.first == v) {
-          e.second.push_back(nrm);
+      for (auto& e : feEdges)
+        if (e.v == v) {
+          if (e.count < 2) e.normal[e.count] = nrm;
+          ++e.count;
           return;
         }
-      edges.push_back({v, {nrm}});
+      feEdges.push_back({v, 1, {nrm, Vec3::Zero()}});
     };
     for (const auto& f : bf) {
       add(f.u, f.normal);
       add(f.v, f.normal);
     }
-    for (const auto& e : edges) {
-      if (e.second.size() != 2) return FeatureEdges{};
-      if (e.second[0].dot(e.second[1]) < cosFeature) fe.to.push_back(e.first);
+    for (const auto& e : feEdges) {
+      if (e.count != 2) return FeatureEdges{};
+      if (e.normal[0].dot(e.normal[1]) < cosFeature) fe.to.push_back(e.v);
     }
     if (fe.to.size() == 2) {
       const Vec3 d0 = (w.x(fe.to[0]) - w.x(n)).normalized(), d1 = (w.x(fe.to[1]) - w.x(n)).normalized();
@@ -598,7 +608,8 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
       for (size_t j = 0; j < bf.size() && !twin; ++j) twin = j != i && bf[i].normal.dot(bf[j].normal) > 1.0 - 1e-9;
       for (const int m : {bf[i].u, bf[i].v}) {
         if (twin) break;
-        for (const auto& g : boundaryFacesOf(m))
+        boundaryFacesOf(m, feBfM);
+        for (const auto& g : feBfM)
           if (g.u != n && g.v != n && bf[i].normal.dot(g.normal) > 1.0 - 1e-9) twin = true;
       }
       fe.polyhedral = twin;
@@ -622,7 +633,8 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
       bool boundary = false, feature = false, boundaryEdge = false;
       Vec3 firstNormal = Vec3::Zero();
       Vec3 normalSum = Vec3::Zero();  // mean boundary normal at n (its tangent plane)
-      for (const BFace& bf : boundaryFacesOf(n)) {
+      boundaryFacesOf(n, candBf);
+      for (const BFace& bf : candBf) {
         if (!boundary) firstNormal = bf.normal;
         normalSum += bf.normal;
         boundary = true;
@@ -742,7 +754,8 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
       // Direction (unit) and the rate at which |phi| grows along it.
       Vec3 dir;
       double rate, maxStep = std::numeric_limits<double>::infinity();
-      const auto bf = boundaryFacesOf(n);
+      boundaryFacesOf(n, candBf);
+      const std::vector<BFace>& bf = candBf;
       if (bf.empty()) {
         dir = sgn * pn;
         rate = 1.0;

@@ -222,10 +222,9 @@ bool CutSurface::intersectSegment(const Eigen::Vector3d& a, const Eigen::Vector3
   double bestT = 2.0;
   int stack[128];
   int top = 0;
-  stack[top++] = 0;
+  if (boxesMeet(nodes_[0].box, segLo, segHi)) stack[top++] = 0;
   while (top > 0) {
     const Node& node = nodes_[stack[--top]];
-    if (!boxesMeet(node.box, segLo, segHi)) continue;
     if (node.left < 0) {
       for (int i = node.begin; i < node.end; ++i) {
         const Tri& tr = leafTri_[i].t;
@@ -248,8 +247,10 @@ bool CutSurface::intersectSegment(const Eigen::Vector3d& a, const Eigen::Vector3
         hit->db = db;
       }
     } else if (top + 2 <= 128) {
-      stack[top++] = node.left;
-      stack[top++] = node.right;
+      // Children whose boxes miss the segment's are not pushed (the same walk, in the same
+      // order, as testing them when popped).
+      if (boxesMeet(nodes_[node.left].box, segLo, segHi)) stack[top++] = node.left;
+      if (boxesMeet(nodes_[node.right].box, segLo, segHi)) stack[top++] = node.right;
     }
   }
   return found;
