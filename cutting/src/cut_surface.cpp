@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <string>
+#include <utility>
 
 namespace hysim::cutting {
 
@@ -21,7 +22,8 @@ Result<CutSurface> CutSurface::plane(const Eigen::Vector3d& point, const Eigen::
 Result<CutSurface> CutSurface::triangles(const Positions& X, const Tris& F) {
   CutSurface s;
   s.is_plane_ = false;
-  s.tri_.reserve(static_cast<size_t>(F.rows()));
+  std::vector<Tri> tri;  // in input order (degenerate ones dropped)
+  tri.reserve(static_cast<size_t>(F.rows()));
   for (Eigen::Index f = 0; f < F.rows(); ++f) {
     for (int k = 0; k < 3; ++k)
       if (F(f, k) < 0 || F(f, k) >= X.rows())
@@ -36,10 +38,10 @@ Result<CutSurface> CutSurface::triangles(const Positions& X, const Tris& F) {
     const double scale = std::max({(t.b - t.a).squaredNorm(), (t.c - t.a).squaredNorm(), (t.c - t.b).squaredNorm()});
     if (!(n.norm() > 1e-12 * scale)) continue;  // degenerate
     t.n = n.normalized();
-    s.tri_.push_back(t);
+    tri.push_back(t);
   }
-  if (s.tri_.empty()) return Error{"cut surface: no non-degenerate triangle"};
-  const int count = static_cast<int>(s.tri_.size());
+  if (tri.empty()) return Error{"cut surface: no non-degenerate triangle"};
+  const int count = static_cast<int>(tri.size());
   s.order_.resize(count);
   for (int i = 0; i < count; ++i) s.order_[i] = i;
   // Per triangle, once: its box, a + b + c (the split key) and its centroid (a + b + c) / 3,
@@ -49,26 +51,27 @@ Result<CutSurface> CutSurface::triangles(const Positions& X, const Tris& F) {
   scratch.hi.resize(count);
   scratch.sum.resize(count);
   scratch.centre.resize(count);
+  scratch.keyed.resize(count);
   for (int i = 0; i < count; ++i) {
-    const Tri& t = s.tri_[i];
+    const Tri& t = tri[i];
     scratch.lo[i] = t.a.cwiseMin(t.b).cwiseMin(t.c);
     scratch.hi[i] = t.a.cwiseMax(t.b).cwiseMax(t.c);
     scratch.sum[i] = t.a + t.b + t.c;
     scratch.centre[i] = scratch.sum[i] / 3.0;
   }
-  s.nodes_.reserve(2 * s.tri_.size());
+  s.nodes_.reserve(2 * tri.size());
   s.build(0, count, scratch);
   s.bounds_ = s.nodes_[0].box;
   // The triangles in tree order (leaf ranges contiguous), with what the segment test needs.
   s.leafTri_.reserve(count);
   for (int i = 0; i < count; ++i) {
-    const Tri& t = s.tri_[s.order_[i]];
+    const Tri& t = tri[s.order_[i]];
     s.leafTri_.push_back({t, t.n.dot((t.b - t.a).cross(t.c - t.a))});
   }
   return s;
 }
 
-int CutSurface::build(int begin, int end, const BuildScratch& scratch) {
+int CutSurface::build(int begin, int end, BuildScratch& scratch) {
   const int id = static_cast<int>(nodes_.size());
   nodes_.emplace_back();
   if (end - begin <= 4) {
@@ -93,9 +96,13 @@ int CutSurface::build(int begin, int end, const BuildScratch& scratch) {
   int axis;
   (chi - clo).maxCoeff(&axis);
   const int mid = (begin + end) / 2;
-  const Eigen::Vector3d* sum = scratch.sum.data();
-  std::nth_element(order_.begin() + begin, order_.begin() + mid, order_.begin() + end,
-                   [sum, axis](int x, int y) { return sum[x][axis] < sum[y][axis]; });
+  // nth_element on (key, triangle) pairs: the same comparisons and moves as on order_ with
+  // the keys looked up, so the same order, without the indirection.
+  std::pair<double, int>* keyed = scratch.keyed.data();
+  for (int i = begin; i < end; ++i) keyed[i] = {scratch.sum[order_[i]][axis], order_[i]};
+  std::nth_element(keyed + begin, keyed + mid, keyed + end,
+                   [](const std::pair<double, int>& x, const std::pair<double, int>& y) { return x.first < y.first; });
+  for (int i = begin; i < end; ++i) order_[i] = keyed[i].second;
   const int left = build(begin, mid, scratch);
   const int right = build(mid, end, scratch);
   nodes_[id].left = left;
@@ -163,7 +170,7 @@ double CutSurface::signedDistanceNear(const Eigen::Vector3d& x, double r, Eigen:
   // lower index), so the result is the same.
   double best = std::isfinite(r) ? r * r * (1.0 + 1e-6) + std::numeric_limits<double>::min()
                                  : std::numeric_limits<double>::infinity();
-  int bestTri = -1;
+  int bestTri = -1, bestLeaf = -1;  // input index (for ties), place in leafTri_
   Eigen::Vector3d bestPoint = x;
   int stack[128];
   int top = 0;
@@ -180,6 +187,7 @@ double CutSurface::signedDistanceNear(const Eigen::Vector3d& x, double r, Eigen:
         if (d2 < best || (d2 == best && order_[i] < bestTri)) {
           best = d2;
           bestTri = order_[i];
+          bestLeaf = i;
           bestPoint = q;
         }
       }
@@ -196,7 +204,8 @@ double CutSurface::signedDistanceNear(const Eigen::Vector3d& x, double r, Eigen:
   if (closest) *closest = bestPoint;
   if (bestTri < 0) return std::numeric_limits<double>::infinity();
   const double d = std::sqrt(best);
-  return tri_[bestTri].n.dot(x - tri_[bestTri].a) < 0 ? -d : d;
+  const Tri& t = leafTri_[bestLeaf].t;
+  return t.n.dot(x - t.a) < 0 ? -d : d;
 }
 
 bool CutSurface::intersectSegment(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double eps, Hit* hit) const {

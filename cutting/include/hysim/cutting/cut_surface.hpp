@@ -15,6 +15,7 @@
 // plane" cuts well defined: those nodes are on the cut and nothing is subdivided there.
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <utility>
 #include <vector>
 
 #include "hysim/cutting/mesh.hpp"
@@ -33,7 +34,7 @@ class CutSurface {
   bool isPlane() const { return is_plane_; }
   const Eigen::Vector3d& planePoint() const { return point_; }
   const Eigen::Vector3d& planeNormal() const { return normal_; }
-  int numTriangles() const { return static_cast<int>(tri_.size()); }
+  int numTriangles() const { return static_cast<int>(leafTri_.size()); }
 
   // Plane: signed distance. Surface: unsigned distance to the nearest triangle, with the sign
   // of that triangle's normal side (only meaningful close to the surface).
@@ -78,15 +79,15 @@ class CutSurface {
   };
   struct BuildScratch {
     std::vector<Eigen::Vector3d> lo, hi, sum, centre;  // per triangle: box, a + b + c, centroid
+    std::vector<std::pair<double, int>> keyed;         // the split's (key, triangle) pairs
   };
-  int build(int begin, int end, const BuildScratch& scratch);
+  int build(int begin, int end, BuildScratch& scratch);
 
   bool is_plane_ = true;
   Eigen::Vector3d point_ = Eigen::Vector3d::Zero(), normal_ = Eigen::Vector3d::UnitZ();
-  std::vector<Tri> tri_;
-  std::vector<int> order_;
+  std::vector<int> order_;        // tree order -> input triangle index
   std::vector<Node> nodes_;
-  std::vector<LeafTri> leafTri_;  // tri_[order_[i]] at i (the leaves' ranges contiguous)
+  std::vector<LeafTri> leafTri_;  // the triangles in tree order: input triangle order_[i] at i
   Eigen::AlignedBox3d bounds_;
 };
 
