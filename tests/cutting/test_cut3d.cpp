@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <limits>
@@ -411,6 +412,68 @@ TEST(Cut3D, SurfaceSignedDistanceNearIsSignedDistance) {
   Vec3 c;
   EXPECT_DOUBLE_EQ(p.signedDistanceNear(Vec3(3, 4, 0.7), 0.01, &c), -0.3);
   EXPECT_TRUE(c.isApprox(Vec3(3, 4, 1)));
+}
+
+// The surface's tree (built once per surface from per-triangle boxes and keys) answers as a
+// walk over every triangle would: the nearest distance, and the nearest crossing of a segment
+// by the documented predicate (both ends off the triangle's plane by more than eps on
+// opposite sides, the crossing inside the triangle with a 1e-12 relative slack).
+TEST(Cut3D, SurfaceTreeQueriesMatchBruteForce) {
+  // A wavy strip of 2 x 48 x 9 triangles (a deep tree), plus a degenerate triangle.
+  const int nu = 48, nv = 9;
+  Positions X((nu + 1) * (nv + 1) + 1, 3);
+  std::vector<std::array<int, 3>> tris;
+  for (int j = 0; j <= nv; ++j)
+    for (int i = 0; i <= nu; ++i)
+      X.row(j * (nu + 1) + i) << 1.2 * i / nu - 0.1, 1.2 * j / nv - 0.1,
+          0.5 + 0.15 * std::sin(7.0 * i / nu) * std::cos(3.0 * j / nv) + 0.01 * std::fmod(i * 0.618 + j * 0.754, 1.0);
+  X.row((nu + 1) * (nv + 1)) = X.row(0);
+  for (int j = 0; j < nv; ++j)
+    for (int i = 0; i < nu; ++i) {
+      const int v00 = j * (nu + 1) + i, v10 = v00 + 1, v01 = v00 + nu + 1, v11 = v01 + 1;
+      tris.push_back({v00, v10, v11});
+      tris.push_back({v00, v11, v01});
+    }
+  tris.push_back({0, (nu + 1) * (nv + 1), 1});  // degenerate: dropped
+  Tris F(static_cast<Eigen::Index>(tris.size()), 3);
+  for (size_t f = 0; f < tris.size(); ++f) F.row(static_cast<Eigen::Index>(f)) << tris[f][0], tris[f][1], tris[f][2];
+  const CutSurface s = *CutSurface::triangles(X, F);
+  ASSERT_EQ(s.numTriangles(), 2 * nu * nv);
+  auto corner = [&](int f, int k) -> Vec3 { return X.row(tris[f][k]).transpose(); };
+  for (int i = 0; i < 600; ++i) {
+    const Vec3 x = pointAroundStrip(i);
+    double best = std::numeric_limits<double>::infinity();
+    for (int f = 0; f < 2 * nu * nv; ++f)
+      best = std::min(best, (closestPointOnTriangle(x, corner(f, 0), corner(f, 1), corner(f, 2)) - x).squaredNorm());
+    EXPECT_EQ(std::abs(s.signedDistance(x)), std::sqrt(best)) << x.transpose();
+  }
+  const double eps = 1e-9;
+  int hits = 0;
+  for (int i = 0; i < 600; ++i) {
+    const Vec3 a = pointAroundStrip(i), b = pointAroundStrip(i + 7919) + Vec3(0, 0, 0.3 * ((i % 3) - 1));
+    double bestT = 2.0;
+    for (int f = 0; f < 2 * nu * nv; ++f) {
+      const Vec3 p0 = corner(f, 0), p1 = corner(f, 1), p2 = corner(f, 2);
+      const Vec3 n = (p1 - p0).cross(p2 - p0).normalized();
+      const double da = n.dot(a - p0), db = n.dot(b - p0);
+      if (!((da > eps && db < -eps) || (da < -eps && db > eps))) continue;
+      const double t = da / (da - db);
+      const Vec3 p = a + t * (b - a);
+      const double slack = -1e-12 * n.dot((p1 - p0).cross(p2 - p0));
+      if (n.dot((p1 - p).cross(p2 - p)) < slack || n.dot((p2 - p).cross(p0 - p)) < slack ||
+          n.dot((p0 - p).cross(p1 - p)) < slack)
+        continue;
+      bestT = std::min(bestT, t);
+    }
+    CutSurface::Hit hit;
+    const bool found = s.intersectSegment(a, b, eps, &hit);
+    EXPECT_EQ(found, bestT < 2.0) << a.transpose() << " / " << b.transpose();
+    if (found && bestT < 2.0) {
+      EXPECT_EQ(hit.t, bestT);
+    }
+    hits += found;
+  }
+  EXPECT_GT(hits, 100);
 }
 
 TEST(Cut3D, PartialCutStaysConnectedAndValid) {
