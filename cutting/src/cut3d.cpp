@@ -1117,7 +1117,9 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
         w.setTet(st[j], tv);
       }
     }
-    std::sort(cutNodes.begin(), cutNodes.end());
+    // The copies were appended in increasing id order, above every node before them: still
+    // sorted (the check is cheap; the sort is kept for safety).
+    if (!std::is_sorted(cutNodes.begin(), cutNodes.end())) std::sort(cutNodes.begin(), cutNodes.end());
   }
   for (const auto& [t, opp] : cutFaceSides) {
     const Tet tv = w.tet(t);
@@ -1156,12 +1158,17 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
   change.element_old_to_new.resize(M0);
   std::iota(change.element_old_to_new.begin(), change.element_old_to_new.end(), 0);
   std::sort(splitOriginals.begin(), splitOriginals.end());
+  // Added: the pieces of the split tets, i.e. each split original (its first piece keeps its
+  // index) and every appended tet (the subdivision appends nothing else), ascending: the
+  // originals (< M0) in order, then M0 .. M1-1.
+  change.removed_elements.reserve(splitOriginals.size());
+  change.added_elements.reserve(splitOriginals.size() + static_cast<size_t>(M1 - M0));
   for (int o : splitOriginals) {
     change.element_old_to_new[o] = -1;
     change.removed_elements.push_back(o);
-    for (int f : fragments[localOf[o]]) change.added_elements.push_back(f);
+    change.added_elements.push_back(o);
   }
-  std::sort(change.added_elements.begin(), change.added_elements.end());
+  for (int t = M0; t < M1; ++t) change.added_elements.push_back(t);
 
   std::vector<std::uint8_t> peeled;  // #M1: slivers the optimisation removed
   // 5. Local optimisation (hybrid), from the nodes the cut created, moved or separated.
