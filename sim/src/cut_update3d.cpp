@@ -186,7 +186,7 @@ double topEigenvalue(const Model& m, const cutting::Positions& X, const std::vec
     // theta has stopped growing over the last steps (it rises towards the top one; near the
     // top the spectrum is dense, so a small residual alone can stop below it).
     history.push_back(theta);
-    const bool settled = size > options.lanczos_min_steps &&
+    const bool settled = size > std::max(options.lanczos_min_steps, 5) &&
                          theta - history[history.size() - 6] <= options.lanczos_tolerance * std::abs(theta);
     const bool last = b <= 1e-14 * std::abs(theta) || j + 1 == max_steps;
     if (settled || last) {
