@@ -59,43 +59,38 @@ double estimateOmegaMax(const Model& m, const cutting::Positions& X, Eigen::Matr
 }  // namespace
 
 void buildStepSprings(Model& m) {
-  // A spring between two anchored nodes never changes length: the step skips it. One pass
-  // over the springs copies the others and counts each node's, then the incidence rows are
-  // filled by index (the arrays keep their capacity between calls).
+  // A spring between two anchored nodes never changes length: the step skips it. Sized by a
+  // counting pass and filled by index (the arrays keep their capacity between calls).
   const int n = m.num_nodes;
   const int ns = static_cast<int>(m.springs.rows());
   StepSprings& st = m.step_springs;
   st.node_offset.assign(n + 1, 0);
-  st.a.resize(ns);
-  st.b.resize(ns);
-  st.rest_length.resize(ns);
-  st.stiffness.resize(ns);
-  st.damping.resize(ns);
-  const std::int32_t* sa = m.springs.col(0).data();
-  const std::int32_t* sb = m.springs.col(1).data();
-  const std::uint8_t* fixed = m.fixed.data();
-  std::int32_t* offset = st.node_offset.data();
   int count = 0;
   for (int s = 0; s < ns; ++s) {
-    const int a = sa[s], b = sb[s];
-    if (fixed[a] && fixed[b]) continue;
-    st.a[count] = a;
-    st.b[count] = b;
-    st.rest_length[count] = m.rest_length[s];
-    st.stiffness[count] = m.stiffness[s];
-    st.damping[count] = m.damping[s];
+    const int a = m.springs(s, 0), b = m.springs(s, 1);
+    if (m.fixed[a] && m.fixed[b]) continue;
     ++count;
-    ++offset[a + 1];
-    ++offset[b + 1];
+    ++st.node_offset[a + 1];
+    ++st.node_offset[b + 1];
   }
   st.a.resize(count);
   st.b.resize(count);
   st.rest_length.resize(count);
   st.stiffness.resize(count);
   st.damping.resize(count);
-  for (int i = 0; i < n; ++i) offset[i + 1] += offset[i];
-  st.incident.resize(offset[n]);
-  st.sign.resize(offset[n]);
+  for (int s = 0, k = 0; s < ns; ++s) {
+    const int a = m.springs(s, 0), b = m.springs(s, 1);
+    if (m.fixed[a] && m.fixed[b]) continue;
+    st.a[k] = a;
+    st.b[k] = b;
+    st.rest_length[k] = m.rest_length[s];
+    st.stiffness[k] = m.stiffness[s];
+    st.damping[k] = m.damping[s];
+    ++k;
+  }
+  for (int i = 0; i < n; ++i) st.node_offset[i + 1] += st.node_offset[i];
+  st.incident.resize(st.node_offset[n]);
+  st.sign.resize(st.node_offset[n]);
   std::vector<int> fill(st.node_offset.begin(), st.node_offset.end() - 1);
   for (int k = 0; k < count; ++k) {
     const int a = st.a[k], b = st.b[k];
