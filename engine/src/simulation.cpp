@@ -187,15 +187,27 @@ bool Simulation::isAnchored(const Eigen::Vector3d& rest) const {
 }
 
 void Simulation::resetState(const sim::NodeVectors* x, const sim::NodeVectors* v) {
-  const int warnings = state_.warnings;
-  const std::uint64_t steps = state_.steps;
-  const double time = state_.time;
-  state_ = sim::makeState(model_, mesh_);
-  if (x != nullptr) state_.x = *x;
-  if (v != nullptr) state_.v = *v;
-  state_.warnings = warnings;
-  state_.steps = steps;
-  state_.time = time;
+  // sim::makeState(model_, mesh_) with x and v given, keeping warnings, steps and time;
+  // each array written once (not zeroed or copied first and then overwritten).
+  const int n = model_.num_nodes;
+  if (x != nullptr) {
+    state_.x = *x;
+  } else {
+    state_.x = mesh_.X;
+  }
+  if (v != nullptr) {
+    state_.v = *v;
+  } else {
+    state_.v.setZero(n, 3);
+  }
+  state_.f.setZero(n, 3);
+  state_.scratch0.setZero(n, 3);
+  state_.scratch1.setZero(n, 3);
+  state_.scratch2.setZero(n, 3);
+  state_.spring_force.setZero(model_.step_springs.size(), 3);
+  state_.solve0.setZero(n, 3);
+  state_.solve1.setZero(n, 3);
+  state_.diverged = false;
   num_anchored_ = 0;
   for (std::uint8_t a : anchored_) num_anchored_ += a;
   num_deformable_tets_ = 0;

@@ -119,6 +119,14 @@ double topEigenvalue(const Model& m, const cutting::Positions& X, const std::vec
   Eigen::MatrixXd Q(n3, max_steps);
   std::vector<double> alpha, beta, history;
   Eigen::VectorXd z(n3);
+  // Reorthogonalisation: Q^T z and Q (Q^T z), evaluated as the expression
+  // z -= Q (Q^T z) evaluates them (into zeroed temporaries, then subtracted), in buffers
+  // allocated once.
+  Eigen::VectorXd q_dot_z(max_steps), q_proj(reorthogonalise ? n3 : 0);
+  // The Ritz values of steps before this one are never read (the settled test looks 5
+  // steps back from beyond lanczos_min_steps): their eigenvalue solves are skipped unless
+  // the breakdown test needs theta (see below).
+  const int first_needed = std::max(1, options.lanczos_min_steps - 4);
   double theta = 0.0;
   Eigen::VectorXd ritz;
   Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(max_steps);
@@ -130,7 +138,11 @@ double topEigenvalue(const Model& m, const cutting::Positions& X, const std::vec
     alpha.push_back(a);
     z -= a * q;
     if (j > 0) z -= beta.back() * Q.col(j - 1);
-    if (reorthogonalise) z -= Q.leftCols(j + 1) * (Q.leftCols(j + 1).transpose() * z);
+    if (reorthogonalise) {
+      q_dot_z.head(j + 1).noalias() = Q.leftCols(j + 1).transpose() * z;
+      q_proj.noalias() = Q.leftCols(j + 1) * q_dot_z.head(j + 1);
+      z -= q_proj;
+    }
     const double b = z.norm();
     const int size = j + 1;
     // T is tridiagonal already: solved as such (Eigen's dense compute() would reduce it by
@@ -146,19 +158,35 @@ double topEigenvalue(const Model& m, const cutting::Positions& X, const std::vec
     for (int i = 0; i + 1 < size; ++i) tri_sub[i] = beta[i] / scale;
     // Eigenvalues only until theta has settled: the Ritz vector (for the residual and the
     // mode) is needed only from then on.
+    // Before first_needed, theta matters only to the breakdown test b <= 1e-14 |theta|; the
+    // top eigenvalue of T is at most scale * max row sum of |T / scale| (Gershgorin), so when
+    // b is above 1e-14 times that bound the test fails whatever theta is, and theta need not
+    // be computed (it is never read: NaN in the history).
+    bool need_theta = size == 1 || size >= first_needed || j + 1 == max_steps;
+    if (!need_theta) {
+      double row_max = 0.0;
+      for (int i = 0; i < size; ++i) {
+        const double row = std::abs(tri_diag[i]) + (i > 0 ? std::abs(tri_sub[i - 1]) : 0.0) +
+                           (i + 1 < size ? std::abs(tri_sub[i]) : 0.0);
+        row_max = std::max(row_max, row);
+      }
+      need_theta = !(b > 1e-14 * (2.0 * row_max * scale));  // 2x: room for round-off in the bound
+    }
     if (size == 1) {
       theta = alpha[0];
       ritz = Eigen::VectorXd::Ones(1);
-    } else {
+    } else if (need_theta) {
       eig.computeFromTridiagonal(tri_diag, tri_sub, Eigen::EigenvaluesOnly);
       theta = eig.eigenvalues()[size - 1] * scale;
+    } else {
+      theta = std::numeric_limits<double>::quiet_NaN();
     }
     if (steps_taken) *steps_taken = size;
     // Converged: the top Ritz pair's residual is small (theta is near *an* eigenvalue) and
     // theta has stopped growing over the last steps (it rises towards the top one; near the
     // top the spectrum is dense, so a small residual alone can stop below it).
     history.push_back(theta);
-    const bool settled = size > options.lanczos_min_steps &&
+    const bool settled = size > std::max(options.lanczos_min_steps, 5) &&
                          theta - history[history.size() - 6] <= options.lanczos_tolerance * std::abs(theta);
     const bool last = b <= 1e-14 * std::abs(theta) || j + 1 == max_steps;
     if (settled || last) {
@@ -371,14 +399,23 @@ Status updateModelAfterCut3D(Model& model, const cutting::TetMesh& before, const
   std::vector<int> unknown;
   // Lumped priors: a quarter of each incident tet's mass, summed over a node's tets in
   // increasing order (one pass over the tets, each volume computed once).
-  for (int t = 0; t < T1; ++t) {
-    const int n0 = after.T(t, 0), n1 = after.T(t, 1), n2 = after.T(t, 2), n3 = after.T(t, 3);
-    if (!(region[n0] | region[n1] | region[n2] | region[n3])) continue;
-    const double w = 0.25 * model.materials[material[t]].density_g_mm3 * std::abs(tetVolume(t));
-    if (region[n0]) mass[n0] += w;
-    if (region[n1]) mass[n1] += w;
-    if (region[n2]) mass[n2] += w;
-    if (region[n3]) mass[n3] += w;
+  // A small region sums over its nodes' tet lists (increasing too: the same sums).
+  auto lumpedShare = [&](int t) { return 0.25 * model.materials[material[t]].density_g_mm3 * std::abs(tetVolume(t)); };
+  std::size_t region_incidences = 0;
+  for (int j : region_nodes) region_incidences += static_cast<std::size_t>(off[j + 1] - off[j]);
+  if (region_incidences < static_cast<std::size_t>(T1)) {
+    for (int j : region_nodes)
+      for (int e = off[j]; e < off[j + 1]; ++e) mass[j] += lumpedShare(around[e]);
+  } else {
+    for (int t = 0; t < T1; ++t) {
+      const int n0 = after.T(t, 0), n1 = after.T(t, 1), n2 = after.T(t, 2), n3 = after.T(t, 3);
+      if (!(region[n0] | region[n1] | region[n2] | region[n3])) continue;
+      const double w = lumpedShare(t);
+      if (region[n0]) mass[n0] += w;
+      if (region[n1]) mass[n1] += w;
+      if (region[n2]) mass[n2] += w;
+      if (region[n3]) mass[n3] += w;
+    }
   }
   for (int j : region_nodes)
     if (mass[j] > 0.0) unknown.push_back(j);
@@ -427,9 +464,29 @@ Status updateModelAfterCut3D(Model& model, const cutting::TetMesh& before, const
   };
   constexpr int kTetEdges[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
   std::vector<int> edge_tets_of;
-  for (int t = 0; t < T1; ++t) {
-    const int n0 = after.T(t, 0), n1 = after.T(t, 1), n2 = after.T(t, 2), n3 = after.T(t, 3);
-    if (touched[n0] + touched[n1] + touched[n2] + touched[n3] >= 2) edge_tets_of.push_back(t);
+  auto touchesTwice = [&](int t) {
+    return touched[after.T(t, 0)] + touched[after.T(t, 1)] + touched[after.T(t, 2)] + touched[after.T(t, 3)] >= 2;
+  };
+  {
+    // Such tets lie around touched nodes: found from their tet lists when that is less work
+    // than a pass over all tets, then put in increasing order.
+    std::size_t touched_incidences = 0;
+    for (int r = 0; r < rep.touched_nodes; ++r)
+      touched_incidences += static_cast<std::size_t>(off[region_nodes[r] + 1] - off[region_nodes[r]]);
+    if (touched_incidences < static_cast<std::size_t>(T1) / 2) {
+      std::vector<std::uint8_t> seen(static_cast<size_t>(T1), 0);
+      for (int r = 0; r < rep.touched_nodes; ++r)
+        for (int e = off[region_nodes[r]]; e < off[region_nodes[r] + 1]; ++e) {
+          const int t = around[e];
+          if (seen[t]) continue;
+          seen[t] = 1;
+          if (touchesTwice(t)) edge_tets_of.push_back(t);
+        }
+      std::sort(edge_tets_of.begin(), edge_tets_of.end());
+    } else {
+      for (int t = 0; t < T1; ++t)
+        if (touchesTwice(t)) edge_tets_of.push_back(t);
+    }
   }
   std::vector<int> bucket(static_cast<size_t>(N1) + 1, 0), by_larger(static_cast<size_t>(N1) + 1, 0);
   auto forTouchedEdges = [&](auto&& f) {
