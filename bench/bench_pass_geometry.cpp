@@ -1,0 +1,76 @@
+// The engine's per-pass geometry work on dumped pass meshes (hysim run --dump-cuts DIR):
+// boundary faces, face matching, the FCL hierarchy build, the tet locator build, pieces.
+// HYSIM_REPLAY_DIR names the folder (default: skipped). Rest positions stand in for the
+// deformed ones.
+#include <benchmark/benchmark.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+#include "hysim/cutting/mesh_io.hpp"
+#include "hysim/engine/collision.hpp"
+#include "hysim/engine/mesh_faces.hpp"
+#include "hysim/engine/tet_locator.hpp"
+
+namespace {
+using namespace hysim;
+
+std::vector<cutting::TetMesh>& meshes() {
+  static std::vector<cutting::TetMesh> all;
+  static bool loaded = false;
+  if (loaded) return all;
+  loaded = true;
+  const char* dir = std::getenv("HYSIM_REPLAY_DIR");
+  if (dir == nullptr) return all;
+  for (int p = 1; p < 200; p += 1) {
+    char name[64];
+    std::snprintf(name, sizeof(name), "/pass_%03d_mesh.msh", p);
+    auto m = cutting::readTetMesh(std::string(dir) + name);
+    if (!m.ok()) break;
+    all.push_back(std::move(*m));
+  }
+  return all;
+}
+
+void BM_CollisionBuild(benchmark::State& state) {
+  auto& ms = meshes();
+  if (ms.empty()) return state.SkipWithError("no HYSIM_REPLAY_DIR");
+  std::vector<cutting::Tris> faces;
+  for (auto& m : ms) faces.push_back(cutting::boundaryFaces(m));
+  engine::TissueCollision c;
+  int same = 0;
+  for (size_t i = 0; i < ms.size(); ++i) same += c.build(faces[i], ms[i].X, 0.5).ok() && c.matchesFclBuild();
+  state.counters["same_tree_as_fcl"] = same;
+  state.counters["meshes"] = static_cast<double>(ms.size());
+  for (auto _ : state)
+    for (size_t i = 0; i < ms.size(); ++i) benchmark::DoNotOptimize(c.build(faces[i], ms[i].X, 0.5).ok());
+}
+BENCHMARK(BM_CollisionBuild)->Unit(benchmark::kMillisecond);
+
+void BM_LocatorBuild(benchmark::State& state) {
+  auto& ms = meshes();
+  if (ms.empty()) return state.SkipWithError("no HYSIM_REPLAY_DIR");
+  engine::TetLocator l;
+  for (auto _ : state)
+    for (auto& m : ms) l.build(m, m.X);
+}
+BENCHMARK(BM_LocatorBuild)->Unit(benchmark::kMillisecond);
+
+void BM_MatchPieces(benchmark::State& state) {
+  auto& ms = meshes();
+  if (ms.empty()) return state.SkipWithError("no HYSIM_REPLAY_DIR");
+  std::vector<int> next;
+  for (auto _ : state)
+    for (auto& m : ms) {
+      engine::matchFaces(m, next);
+      std::vector<std::uint8_t> anchored(m.numNodes(), 0);
+      anchored[0] = 1;
+      benchmark::DoNotOptimize(engine::tetPieces(m, next, anchored).count);
+    }
+}
+BENCHMARK(BM_MatchPieces)->Unit(benchmark::kMillisecond);
+
+}  // namespace
+BENCHMARK_MAIN();
