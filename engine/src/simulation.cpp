@@ -207,7 +207,11 @@ void Simulation::resetState(const sim::NodeVectors* x, const sim::NodeVectors* v
 }
 
 Status Simulation::rebuildGeometry(PassRecord* timing, const std::vector<std::uint8_t>* boundary) {
+  waitLocator();
   if (Status st = buildGeometry(mesh_, state_.x, timing, boundary); !st.ok()) return st;
+  PassTimer timer;
+  locator_.build(mesh_, state_.x);
+  timer.lap(timing ? &timing->locator_ms : nullptr);
   finishGeometry(timing);
   return Status::Ok();
 }
@@ -258,10 +262,14 @@ Status Simulation::buildGeometry(const cutting::TetMesh& mesh, const sim::NodeVe
   // the loop moves less than that, a step only moves the vertices (see collision.hpp).
   if (Status st = collision_.build(surface_faces_, x, 0.5); !st.ok()) return st;
   timer.lap(timing ? &timing->collision_ms : nullptr);
-  locator_.build(mesh, x);
-  timer.lap(timing ? &timing->locator_ms : nullptr);
   return Status::Ok();
 }
+
+void Simulation::waitLocator() const {
+  if (locator_thread_.joinable()) locator_thread_.join();
+}
+
+Simulation::~Simulation() { waitLocator(); }
 
 void Simulation::finishGeometry(PassRecord* timing) {
   PassTimer timer;
@@ -396,6 +404,7 @@ bool Simulation::loopTouchesTissue() {
   // inside or wholly outside the tissue, and one of its points tells which. It stays on that
   // side until the next contact, so the test runs once per contact-free stretch.
   if (!buried_known_) {
+    waitLocator();  // the last pass's build (allocates nothing; long done by now, in practice)
     double moved = locator_.maxDisplacement(state_.x);
     if (moved > locator_.margin()) {
       locator_.build(mesh_, state_.x);
@@ -491,6 +500,7 @@ void Simulation::checkPerforation() {
 
 void Simulation::finishPass() {
   using Clock = std::chrono::steady_clock;
+  waitLocator();  // the previous pass's build, before the clock starts (see PassRecord::locator_ms)
   const auto t0 = Clock::now();
   PassTimer timer;
   cutting_ = false;
@@ -750,8 +760,8 @@ void Simulation::finishPass() {
   timer.lap(&rec.chips_ms);
   // The tissue model, updated around the cut (moment-preserving masses, Van Gelder springs,
   // stability estimate near the cut); the chips leave with their masses.
-  // Meanwhile a second thread builds the kept mesh's boundary, render surface, FCL hierarchy
-  // and tet locator (buildGeometry): they depend on the kept mesh and positions only, the
+  // Meanwhile a second thread builds the kept mesh's boundary, render surface and FCL
+  // hierarchy (buildGeometry): they depend on the kept mesh and positions only, the
   // model update on neither, and each writes its own members, so the result is the same as
   // one after the other.
   Status geometry;
@@ -814,6 +824,18 @@ void Simulation::finishPass() {
   rec.other_ms = std::max(0.0, rec.cut_ms - (rec.map_ms + rec.cut3d_ms + rec.remap_ms + rec.components_ms + rec.model_ms +
                                              rec.geometry_wait_ms + rec.chips_ms + rec.stats_ms));
   passes_.push_back(rec);
+  // The tet locator of the new mesh (for the buried-wire test and the next pass's map) is
+  // built on a background thread after the pass, beside the steps that follow: they do not
+  // read it, and whoever does first waits for it (waitLocator). It reads mesh_ (unchanged
+  // until the next pass, which waits first) and its own copy of the positions at the cut,
+  // so it is the same locator as one built here. Its time goes to this pass's locator_ms
+  // (passes_ grows only in finishPass, after the wait).
+  double* locator_ms = &passes_.back().locator_ms;
+  locator_thread_ = std::thread([this, x = std::move(x_kept), locator_ms] {
+    PassTimer build_timer;
+    locator_.build(mesh_, x);
+    build_timer.lap(locator_ms);
+  });
 }
 
 void Simulation::fillSnapshot(render::RenderSnapshot& snap) const {
