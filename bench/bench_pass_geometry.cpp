@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "hysim/cutting/cut3d.hpp"
 #include "hysim/cutting/mesh_io.hpp"
 #include "hysim/engine/collision.hpp"
 #include "hysim/engine/mesh_faces.hpp"
@@ -71,6 +72,63 @@ void BM_MatchPieces(benchmark::State& state) {
     }
 }
 BENCHMARK(BM_MatchPieces)->Unit(benchmark::kMillisecond);
+
+// updateFaces + tetPieces after each dumped pass's hybrid cut (as Simulation::finishPass).
+void BM_FacesPieces(benchmark::State& state) {
+  struct Pass {
+    cutting::TetMesh before, after;
+    cutting::TopologyChange change;
+    std::vector<int> next_before;
+    std::vector<std::uint8_t> anchored;
+  };
+  static std::vector<Pass> passes = [] {
+    std::vector<Pass> out;
+    const char* dir = std::getenv("HYSIM_REPLAY_DIR");
+    if (dir == nullptr) return out;
+    for (int i = 1;; ++i) {
+      char name[32];
+      std::snprintf(name, sizeof(name), "/pass_%03d_", i);
+      auto m = cutting::readTetMesh(std::string(dir) + name + "mesh.msh");
+      auto tri = cutting::readTriMesh(std::string(dir) + name + "surface.msh");
+      if (!m.ok() || !tri.ok()) break;
+      auto s = cutting::CutSurface::triangles(tri->X, tri->F);
+      if (!s.ok()) break;
+      cutting::Cut3DOptions o;
+      o.method = cutting::CutMethod::Hybrid;
+      auto r = cutting::cut3d(*m, *s, o);
+      if (!r.ok()) break;
+      Pass p;
+      p.before = std::move(*m);
+      p.after = std::move(r->mesh);
+      p.change = std::move(r->change);
+      engine::matchFaces(p.before, p.next_before);
+      p.anchored.assign(static_cast<size_t>(p.after.numNodes()), 0);
+      for (int n = 0; n < p.after.numNodes(); ++n) {
+        const Eigen::Vector3d x = p.after.X.row(n).transpose();
+        p.anchored[n] = (x.array() / Eigen::Array3d(25, 20, 33)).matrix().squaredNorm() > 1.0;
+      }
+      out.push_back(std::move(p));
+    }
+    return out;
+  }();
+  if (passes.empty()) return state.SkipWithError("no HYSIM_REPLAY_DIR");
+  std::vector<int> next;
+  int chips = 0;
+  for (auto _ : state) {
+    chips = 0;
+    for (const Pass& p : passes) {
+      if (!engine::updateFaces(p.before, p.next_before, p.after, p.change.node_old_to_new,
+                               p.change.element_old_to_new, next)) {
+        return state.SkipWithError("updateFaces failed");
+      }
+      const engine::Pieces c = engine::tetPieces(p.after, next, p.anchored);
+      for (int k = 0; k < c.count; ++k) chips += c.free[k];
+    }
+  }
+  state.counters["chips"] = chips;
+  state.counters["passes"] = static_cast<double>(passes.size());
+}
+BENCHMARK(BM_FacesPieces)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 BENCHMARK_MAIN();
