@@ -73,6 +73,53 @@ void BM_MatchPieces(benchmark::State& state) {
 }
 BENCHMARK(BM_MatchPieces)->Unit(benchmark::kMillisecond);
 
+// The map's point location: each dumped pass's sweep points (rest shape) in its mesh, the
+// locator built at rest, queried with a displacement bound of range(0) / 10 mm.
+void BM_Locate(benchmark::State& state) {
+  struct Pass {
+    cutting::TetMesh mesh;
+    cutting::Positions points;
+    sim::NodeVectors x;
+    engine::TetLocator locator;
+  };
+  static std::vector<Pass> passes = [] {
+    std::vector<Pass> out;
+    const char* dir = std::getenv("HYSIM_REPLAY_DIR");
+    if (dir == nullptr) return out;
+    for (int i = 1;; ++i) {
+      char name[32];
+      std::snprintf(name, sizeof(name), "/pass_%03d_", i);
+      auto m = cutting::readTetMesh(std::string(dir) + name + "mesh.msh");
+      auto tri = cutting::readTriMesh(std::string(dir) + name + "surface.msh");
+      if (!m.ok() || !tri.ok()) break;
+      Pass p;
+      p.mesh = std::move(*m);
+      p.points = tri->X;
+      p.x = p.mesh.X;
+      p.locator.build(p.mesh, p.x);
+      out.push_back(std::move(p));
+    }
+    return out;
+  }();
+  if (passes.empty()) return state.SkipWithError("no HYSIM_REPLAY_DIR");
+  const double moved = static_cast<double>(state.range(0)) / 10.0;
+  long inside = 0, total = 0, sum = 0;
+  for (auto _ : state) {
+    inside = total = sum = 0;
+    for (const Pass& p : passes)
+      for (Eigen::Index i = 0; i < p.points.rows(); ++i) {
+        const int t = p.locator.locate(p.mesh, p.x, p.points.row(i).transpose(), moved);
+        inside += t >= 0;
+        sum += t;
+        ++total;
+      }
+  }
+  state.counters["inside"] = static_cast<double>(inside);
+  state.counters["points"] = static_cast<double>(total);
+  state.counters["tet_sum"] = static_cast<double>(sum);
+}
+BENCHMARK(BM_Locate)->Arg(0)->Arg(5)->Arg(10)->Unit(benchmark::kMillisecond);
+
 // updateFaces + tetPieces after each dumped pass's hybrid cut (as Simulation::finishPass).
 void BM_FacesPieces(benchmark::State& state) {
   struct Pass {
