@@ -537,9 +537,11 @@ void Simulation::finishPass() {
     if (moved >= 0.3 || r == rows - 1) kept_rows.push_back(r);
   }
   // A query looks at the cells within the nodes' largest displacement since the build: past
-  // a millimetre, a fresh build (~0.6 ms) costs less than the sweep's ~1000 queries.
+  // half a millimetre, a fresh build (~0.6 ms) costs less than the sweep's ~1000 queries
+  // (bench_pass_geometry on the 52 dumped passes: all queries ~0.4 ms + 1.2 ms per mm of
+  // displacement). The answers are the same either way.
   double displacement = locator_.maxDisplacement(state_.x);  // since the locator's build
-  if (displacement > 1.0) {
+  if (displacement > 0.5) {
     locator_.build(mesh_, state_.x);
     displacement = 0.0;
   }
@@ -714,6 +716,28 @@ void Simulation::finishPass() {
     for (size_t k = 0; k < keep_tets.size(); ++k)
       for (int f = 0; f < 4; ++f) kept_boundary[4 * k + f] = face_next[4 * static_cast<size_t>(keep_tets[k]) + f] < 0;
   }
+  // Nodes on a cut surface, this pass's and earlier ones', in the new numbering.
+  std::vector<std::uint8_t> on_cut(n, 0);
+  for (int i = 0; i < static_cast<int>(change.node_old_to_new.size()); ++i) {
+    const int j = change.node_old_to_new[i];
+    if (j >= 0 && i < static_cast<int>(on_cut_.size()) && on_cut_[i]) on_cut[j] = 1;
+  }
+  for (int c : change.cut_nodes) {
+    if (c >= 0 && c < n) on_cut[c] = 1;
+  }
+  on_cut_.assign(kept_nodes, 0);
+  for (int i = 0; i < n; ++i) {
+    if (new_index[i] >= 0) on_cut_[new_index[i]] = on_cut[i];
+  }
+  // Meanwhile a second thread builds the kept mesh's boundary, render surface and FCL
+  // hierarchy (buildGeometry), as soon as its inputs exist: they depend on the kept mesh,
+  // positions and on-cut flags only, what this thread does until the join (face neighbours,
+  // serosa, chips, the model update) on none of them, and each writes its own members, so
+  // the result is the same as one after the other.
+  Status geometry;
+  std::thread geometry_thread([&] {
+    geometry = buildGeometry(rest_mesh, x_kept, &rec, kept_boundary.empty() ? nullptr : &kept_boundary);
+  });
   // The kept mesh's face neighbours, for the next pass (a kept tet's neighbours are kept).
   std::vector<int> kept_next;
   if (!face_next.empty()) {
@@ -729,19 +753,6 @@ void Simulation::finishPass() {
         }
         kept_next[4 * k + f] = p < 0 ? -1 : 4 * kept_of[p / 4] + p % 4;
       }
-  }
-  // Nodes on a cut surface, this pass's and earlier ones', in the new numbering.
-  std::vector<std::uint8_t> on_cut(n, 0);
-  for (int i = 0; i < static_cast<int>(change.node_old_to_new.size()); ++i) {
-    const int j = change.node_old_to_new[i];
-    if (j >= 0 && i < static_cast<int>(on_cut_.size()) && on_cut_[i]) on_cut[j] = 1;
-  }
-  for (int c : change.cut_nodes) {
-    if (c >= 0 && c < n) on_cut[c] = 1;
-  }
-  on_cut_.assign(kept_nodes, 0);
-  for (int i = 0; i < n; ++i) {
-    if (new_index[i] >= 0) on_cut_[new_index[i]] = on_cut[i];
   }
   // The serosa follows its nodes into the new numbering.
   std::vector<int> old_to_kept(change.node_old_to_new.size(), -1);
@@ -760,14 +771,6 @@ void Simulation::finishPass() {
   timer.lap(&rec.chips_ms);
   // The tissue model, updated around the cut (moment-preserving masses, Van Gelder springs,
   // stability estimate near the cut); the chips leave with their masses.
-  // Meanwhile a second thread builds the kept mesh's boundary, render surface and FCL
-  // hierarchy (buildGeometry): they depend on the kept mesh and positions only, the
-  // model update on neither, and each writes its own members, so the result is the same as
-  // one after the other.
-  Status geometry;
-  std::thread geometry_thread([&] {
-    geometry = buildGeometry(rest_mesh, x_kept, &rec, kept_boundary.empty() ? nullptr : &kept_boundary);
-  });
   sim::CutUpdate3DReport update;
   const Status model_status =
       sim::updateModelAfterCut3D(model_, mesh_, after, change, anchored_after, new_index, {}, &update);
