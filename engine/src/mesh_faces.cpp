@@ -83,6 +83,21 @@ bool updateFaces(const cutting::TetMesh& before, const std::vector<int>& next_be
   for (int u = 0; u < T1; ++u)
     if (old_of[u] < 0)
       for (int k = 0; k < 4; ++k) changed_node[after.T(u, k)] = 1;
+  // Per old slot, its neighbour slot and its own new slot (-1: its element was not kept as
+  // it was), side by side: the neighbour's pair is then one memory access (the neighbour is
+  // anywhere in the mesh; this loop was mostly waiting for those reads).
+  struct OldSlot {
+    int next, now;
+  };
+  std::vector<OldSlot> old_slot(4 * static_cast<size_t>(T0));
+  for (int t = 0; t < T0; ++t) {
+    const int u = element_old_to_new[t];
+    const bool kept = u >= 0 && u < T1 && old_of[u] == t;
+    for (int f = 0; f < 4; ++f) {
+      const size_t s = 4 * static_cast<size_t>(t) + f;
+      old_slot[s] = {next_before[s], kept ? 4 * u + f : -1};
+    }
+  }
   std::vector<int> out(4 * static_cast<size_t>(T1), -1);
   std::vector<int> open;  // slots to match among themselves
   for (int u = 0; u < T1; ++u) {
@@ -93,12 +108,12 @@ bool updateFaces(const cutting::TetMesh& before, const std::vector<int>& next_be
         open.push_back(s);
         continue;
       }
-      const int p = next_before[4 * static_cast<size_t>(o) + f];
+      const int p = old_slot[4 * static_cast<size_t>(o) + f].next;
       if (p >= 0) {
-        const int u2 = p / 4 < T0 ? element_old_to_new[p / 4] : -1;
         // Kept when both elements are kept as they were and the face had just the two.
-        if (u2 >= 0 && u2 < T1 && old_of[u2] == p / 4 && next_before[p] == 4 * o + f) {
-          out[s] = 4 * u2 + p % 4;
+        const OldSlot other = p / 4 < T0 ? old_slot[static_cast<size_t>(p)] : OldSlot{-1, -1};
+        if (other.now >= 0 && other.next == 4 * o + f) {
+          out[s] = other.now;
         } else {
           open.push_back(s);
         }

@@ -219,7 +219,11 @@ void Simulation::resetState(const sim::NodeVectors* x, const sim::NodeVectors* v
 }
 
 Status Simulation::rebuildGeometry(PassRecord* timing, const std::vector<std::uint8_t>* boundary) {
+  waitLocator();
   if (Status st = buildGeometry(mesh_, state_.x, timing, boundary); !st.ok()) return st;
+  PassTimer timer;
+  locator_.build(mesh_, state_.x);
+  timer.lap(timing ? &timing->locator_ms : nullptr);
   finishGeometry(timing);
   return Status::Ok();
 }
@@ -270,10 +274,14 @@ Status Simulation::buildGeometry(const cutting::TetMesh& mesh, const sim::NodeVe
   // the loop moves less than that, a step only moves the vertices (see collision.hpp).
   if (Status st = collision_.build(surface_faces_, x, 0.5); !st.ok()) return st;
   timer.lap(timing ? &timing->collision_ms : nullptr);
-  locator_.build(mesh, x);
-  timer.lap(timing ? &timing->locator_ms : nullptr);
   return Status::Ok();
 }
+
+void Simulation::waitLocator() const {
+  if (locator_thread_.joinable()) locator_thread_.join();
+}
+
+Simulation::~Simulation() { waitLocator(); }
 
 void Simulation::finishGeometry(PassRecord* timing) {
   PassTimer timer;
@@ -408,6 +416,7 @@ bool Simulation::loopTouchesTissue() {
   // inside or wholly outside the tissue, and one of its points tells which. It stays on that
   // side until the next contact, so the test runs once per contact-free stretch.
   if (!buried_known_) {
+    waitLocator();  // the last pass's build (allocates nothing; long done by now, in practice)
     double moved = locator_.maxDisplacement(state_.x);
     if (moved > locator_.margin()) {
       locator_.build(mesh_, state_.x);
@@ -503,6 +512,7 @@ void Simulation::checkPerforation() {
 
 void Simulation::finishPass() {
   using Clock = std::chrono::steady_clock;
+  waitLocator();  // the previous pass's build, before the clock starts (see PassRecord::locator_ms)
   const auto t0 = Clock::now();
   PassTimer timer;
   cutting_ = false;
@@ -539,9 +549,11 @@ void Simulation::finishPass() {
     if (moved >= 0.3 || r == rows - 1) kept_rows.push_back(r);
   }
   // A query looks at the cells within the nodes' largest displacement since the build: past
-  // a millimetre, a fresh build (~0.6 ms) costs less than the sweep's ~1000 queries.
+  // half a millimetre, a fresh build (~0.6 ms) costs less than the sweep's ~1000 queries
+  // (bench_pass_geometry on the 52 dumped passes: all queries ~0.4 ms + 1.2 ms per mm of
+  // displacement). The answers are the same either way.
   double displacement = locator_.maxDisplacement(state_.x);  // since the locator's build
-  if (displacement > 1.0) {
+  if (displacement > 0.5) {
     locator_.build(mesh_, state_.x);
     displacement = 0.0;
   }
@@ -716,6 +728,28 @@ void Simulation::finishPass() {
     for (size_t k = 0; k < keep_tets.size(); ++k)
       for (int f = 0; f < 4; ++f) kept_boundary[4 * k + f] = face_next[4 * static_cast<size_t>(keep_tets[k]) + f] < 0;
   }
+  // Nodes on a cut surface, this pass's and earlier ones', in the new numbering.
+  std::vector<std::uint8_t> on_cut(n, 0);
+  for (int i = 0; i < static_cast<int>(change.node_old_to_new.size()); ++i) {
+    const int j = change.node_old_to_new[i];
+    if (j >= 0 && i < static_cast<int>(on_cut_.size()) && on_cut_[i]) on_cut[j] = 1;
+  }
+  for (int c : change.cut_nodes) {
+    if (c >= 0 && c < n) on_cut[c] = 1;
+  }
+  on_cut_.assign(kept_nodes, 0);
+  for (int i = 0; i < n; ++i) {
+    if (new_index[i] >= 0) on_cut_[new_index[i]] = on_cut[i];
+  }
+  // Meanwhile a second thread builds the kept mesh's boundary, render surface and FCL
+  // hierarchy (buildGeometry), as soon as its inputs exist: they depend on the kept mesh,
+  // positions and on-cut flags only, what this thread does until the join (face neighbours,
+  // serosa, chips, the model update) on none of them, and each writes its own members, so
+  // the result is the same as one after the other.
+  Status geometry;
+  std::thread geometry_thread([&] {
+    geometry = buildGeometry(rest_mesh, x_kept, &rec, kept_boundary.empty() ? nullptr : &kept_boundary);
+  });
   // The kept mesh's face neighbours, for the next pass (a kept tet's neighbours are kept).
   std::vector<int> kept_next;
   if (!face_next.empty()) {
@@ -731,19 +765,6 @@ void Simulation::finishPass() {
         }
         kept_next[4 * k + f] = p < 0 ? -1 : 4 * kept_of[p / 4] + p % 4;
       }
-  }
-  // Nodes on a cut surface, this pass's and earlier ones', in the new numbering.
-  std::vector<std::uint8_t> on_cut(n, 0);
-  for (int i = 0; i < static_cast<int>(change.node_old_to_new.size()); ++i) {
-    const int j = change.node_old_to_new[i];
-    if (j >= 0 && i < static_cast<int>(on_cut_.size()) && on_cut_[i]) on_cut[j] = 1;
-  }
-  for (int c : change.cut_nodes) {
-    if (c >= 0 && c < n) on_cut[c] = 1;
-  }
-  on_cut_.assign(kept_nodes, 0);
-  for (int i = 0; i < n; ++i) {
-    if (new_index[i] >= 0) on_cut_[new_index[i]] = on_cut[i];
   }
   // The serosa follows its nodes into the new numbering.
   std::vector<int> old_to_kept(change.node_old_to_new.size(), -1);
@@ -762,14 +783,6 @@ void Simulation::finishPass() {
   timer.lap(&rec.chips_ms);
   // The tissue model, updated around the cut (moment-preserving masses, Van Gelder springs,
   // stability estimate near the cut); the chips leave with their masses.
-  // Meanwhile a second thread builds the kept mesh's boundary, render surface, FCL hierarchy
-  // and tet locator (buildGeometry): they depend on the kept mesh and positions only, the
-  // model update on neither, and each writes its own members, so the result is the same as
-  // one after the other.
-  Status geometry;
-  std::thread geometry_thread([&] {
-    geometry = buildGeometry(rest_mesh, x_kept, &rec, kept_boundary.empty() ? nullptr : &kept_boundary);
-  });
   sim::CutUpdate3DReport update;
   const Status model_status =
       sim::updateModelAfterCut3D(model_, mesh_, after, change, anchored_after, new_index, {}, &update);
@@ -826,6 +839,18 @@ void Simulation::finishPass() {
   rec.other_ms = std::max(0.0, rec.cut_ms - (rec.map_ms + rec.cut3d_ms + rec.remap_ms + rec.components_ms + rec.model_ms +
                                              rec.geometry_wait_ms + rec.chips_ms + rec.stats_ms));
   passes_.push_back(rec);
+  // The tet locator of the new mesh (for the buried-wire test and the next pass's map) is
+  // built on a background thread after the pass, beside the steps that follow: they do not
+  // read it, and whoever does first waits for it (waitLocator). It reads mesh_ (unchanged
+  // until the next pass, which waits first) and its own copy of the positions at the cut,
+  // so it is the same locator as one built here. Its time goes to this pass's locator_ms
+  // (passes_ grows only in finishPass, after the wait).
+  double* locator_ms = &passes_.back().locator_ms;
+  locator_thread_ = std::thread([this, x = std::move(x_kept), locator_ms] {
+    PassTimer build_timer;
+    locator_.build(mesh_, x);
+    build_timer.lap(locator_ms);
+  });
 }
 
 void Simulation::fillSnapshot(render::RenderSnapshot& snap) const {

@@ -7,6 +7,14 @@
 #include <limits>
 
 namespace hysim::engine {
+namespace {
+
+// A float at or below (above) v: a box rounded outwards. The cast rounds to the nearest float
+// (within 2^-24 |v|); two float steps more make sure of the side.
+float roundDown(double v) { return static_cast<float>(v - 2.4e-7 * std::abs(v) - 1e-30); }
+float roundUp(double v) { return static_cast<float>(v + 2.4e-7 * std::abs(v) + 1e-30); }
+
+}  // namespace
 
 void TetLocator::build(const cutting::TetMesh& mesh, const sim::NodeVectors& x, double margin_mm) {
   margin_ = margin_mm;
@@ -16,7 +24,7 @@ void TetLocator::build(const cutting::TetMesh& mesh, const sim::NodeVectors& x, 
   dims_.setZero();
   if (nt == 0 || x.rows() == 0) {
     cell_start_.clear();
-    cell_tets_.clear();
+    cell_boxes_.clear();
     return;
   }
   Eigen::Vector3d lo = x.colwise().minCoeff().transpose(), hi = x.colwise().maxCoeff().transpose();
@@ -68,15 +76,28 @@ void TetLocator::build(const cutting::TetMesh& mesh, const sim::NodeVectors& x, 
         for (int i = a.x(); i <= b.x(); ++i) ++count[index(i, j, k) + 1];
   }
   for (long c = 0; c < cells; ++c) count[c + 1] += count[c];
-  cell_tets_.resize(cell_start_.back());
   std::vector<int>& fill = fill_;
   fill.assign(cell_start_.begin(), cell_start_.end() - 1);
+  // Each entry also holds its tet's build box grown by the query filter's relative part
+  // (1e-6 of its largest extent, see locate()) and rounded outwards to floats: the filter
+  // then reads the cell's entries in order instead of each tet's box elsewhere.
+  cell_boxes_.resize(static_cast<size_t>(cell_start_.back()));
   for (int t = 0; t < nt; ++t) {
     const Eigen::Vector3i& a = ranges_[2 * static_cast<size_t>(t)];
     const Eigen::Vector3i& b = ranges_[2 * static_cast<size_t>(t) + 1];
+    const double* box = &boxes_[6 * static_cast<size_t>(t)];
+    const double pad = 1e-6 * std::max({box[3] - box[0], box[4] - box[1], box[5] - box[2]});
+    Entry entry;
+    entry.tet = t;
+    for (int c = 0; c < 3; ++c) {
+      entry.lo[c] = roundDown(box[c] - pad);
+      entry.hi[c] = roundUp(box[3 + c] + pad);
+    }
     for (int k = a.z(); k <= b.z(); ++k)
       for (int j = a.y(); j <= b.y(); ++j)
-        for (int i = a.x(); i <= b.x(); ++i) cell_tets_[fill[index(i, j, k)]++] = t;
+        for (int i = a.x(); i <= b.x(); ++i) {
+          cell_boxes_[fill[index(i, j, k)]++] = entry;
+        }
   }
 }
 
@@ -95,6 +116,10 @@ int TetLocator::locate(const cutting::TetMesh& mesh, const sim::NodeVectors& x, 
     lo[c] = static_cast<int>(std::max(a, 0.0));
     hi[c] = static_cast<int>(std::min(b, static_cast<double>(dims_[c] - 1)));
   }
+  // An entry's box is grown by 1e-6 of its extent already; the rest of the growth is
+  // moved + 1e-6 (2 moved) + 1e-9 (the tet's extent now is at most its build extent + 2 moved),
+  // with another 1e-9 for rounding.
+  const double grow = moved + 2e-6 * moved + 2e-9;
   // The lowest-numbered tet that holds p (a point on a shared face lies in several): the
   // same answer whichever cells list it.
   int best = -1;
@@ -103,9 +128,16 @@ int TetLocator::locate(const cutting::TetMesh& mesh, const sim::NodeVectors& x, 
       for (int i = lo[0]; i <= hi[0]; ++i) {
         const long cell = (static_cast<long>(k) * dims_.y() + j) * dims_.x() + i;
         for (int e = cell_start_[cell]; e < cell_start_[cell + 1]; ++e) {
-          const int t = cell_tets_[e];
+          const Entry& entry = cell_boxes_[e];
+          const int t = entry.tet;
           if (best >= 0 && t >= best) break;  // a cell lists its tets in increasing order
-          if (contains(mesh, x, t, p, moved)) {
+          // Tets whose build box, grown by how far the nodes may have moved and by
+          // containsNow()'s tolerance, does not hold p would fail containsNow() too.
+          if (p[0] < entry.lo[0] - grow || p[1] < entry.lo[1] - grow || p[2] < entry.lo[2] - grow ||
+              p[0] > entry.hi[0] + grow || p[1] > entry.hi[1] + grow || p[2] > entry.hi[2] + grow) {
+            continue;
+          }
+          if (containsNow(mesh, x, t, p)) {
             best = t;
             break;
           }
@@ -114,18 +146,11 @@ int TetLocator::locate(const cutting::TetMesh& mesh, const sim::NodeVectors& x, 
   return best;
 }
 
-bool TetLocator::contains(const cutting::TetMesh& mesh, const sim::NodeVectors& x, int t, const Eigen::Vector3d& p,
-                          double moved) const {
-  // The box at the build, grown by how far the nodes may have moved since and the test's
-  // tolerance below (for the largest box the tet can have now), holds the box below: a
-  // point outside it fails that test too, without reading the tet's nodes.
-  const double* box = &boxes_[6 * static_cast<size_t>(t)];
-  const double built = std::max({box[3] - box[0], box[4] - box[1], box[5] - box[2]});
-  const double grow = moved + 1e-6 * (built + 2.0 * moved) + 1e-9;
-  if (p[0] < box[0] - grow || p[1] < box[1] - grow || p[2] < box[2] - grow || p[0] > box[3] + grow ||
-      p[1] > box[4] + grow || p[2] > box[5] + grow) {
-    return false;
-  }
+// Whether p lies in tet t at positions x. (locate() first drops the tets whose build box,
+// grown by how far the nodes may have moved since and by this test's tolerance below for the
+// largest box the tet can have now, does not hold p: they would fail this test too.)
+bool TetLocator::containsNow(const cutting::TetMesh& mesh, const sim::NodeVectors& x, int t,
+                             const Eigen::Vector3d& p) const {
   const Eigen::Vector3d a = x.row(mesh.T(t, 0)).transpose();
   Eigen::Matrix3d m;
   for (int k = 0; k < 3; ++k) m.col(k) = x.row(mesh.T(t, k + 1)).transpose() - a;

@@ -4,6 +4,7 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "hysim/cutting/mesh.hpp"
@@ -31,11 +32,13 @@ struct PassRecord {
   // cutting::cut3d, current positions of the cut mesh, free pieces found and removed (mesh
   // compacted), the tissue model (masses, springs, stability), boundary/render/contact
   // arrays, the FCL hierarchy, the tet locator, chip shapes and bodies, mesh statistics;
-  // other_ms is what is left (cut_ms minus the parts). In a pass the boundary, FCL hierarchy
-  // and locator (surface_ms, collision_ms, locator_ms: that thread's wall time) are built on a
-  // second thread while this one updates the model (model_ms); geometry_wait_ms is how long
-  // this thread then waited for them (what they add to cut_ms), and other_ms is computed
-  // with geometry_wait_ms in place of those three.
+  // other_ms is what is left (cut_ms minus the parts). In a pass the boundary and FCL
+  // hierarchy (surface_ms, collision_ms: that thread's wall time) are built on a second thread
+  // while this one updates the model (model_ms); geometry_wait_ms is how long this thread
+  // then waited for them (what they add to cut_ms), and other_ms is computed with
+  // geometry_wait_ms in place of those two. The tet locator (locator_ms) is built on a
+  // background thread after the pass has ended, beside the following steps, and is not part
+  // of cut_ms (at the start of a run, setTopology builds it in place).
   double map_ms = 0.0, cut3d_ms = 0.0, remap_ms = 0.0, components_ms = 0.0, model_ms = 0.0, surface_ms = 0.0,
          collision_ms = 0.0, locator_ms = 0.0, chips_ms = 0.0, stats_ms = 0.0, other_ms = 0.0,
          geometry_wait_ms = 0.0;
@@ -65,6 +68,7 @@ class Simulation {
  public:
   // Loads the meshes named by the scene, anchors nodes, builds the tissue model.
   static Result<std::unique_ptr<Simulation>> create(const Scene& scene);
+  ~Simulation();  // waits for a locator build still running
 
   // Advances one fixed step. Allocates nothing, also while the loop cuts through tissue,
   // except on the step a shaving pass ends (the loop leaves the tissue), when the cut
@@ -95,7 +99,10 @@ class Simulation {
   // Wall time spent stepping the chips (Bullet), seconds, and the steps that had chips.
   double chipStepSeconds() const { return chip_step_s_; }
   long chipSteps() const { return chip_steps_; }
-  const std::vector<PassRecord>& passes() const { return passes_; }
+  const std::vector<PassRecord>& passes() const {
+    waitLocator();  // the last pass's locator_ms
+    return passes_;
+  }
   bool loopInTissue() const { return loop_in_tissue_; }
   const LoopGeometry& loop() const { return loop_; }
   int topologyVersion() const { return topology_version_; }
@@ -140,9 +147,10 @@ class Simulation {
   // on the boundary, when the caller knows; else they are found from mesh_.
   Status rebuildGeometry(PassRecord* timing, const std::vector<std::uint8_t>* boundary = nullptr);
   // rebuildGeometry's first part, for `mesh` at positions x (the next mesh_ and state_.x): the
-  // boundary faces, render surface, FCL hierarchy and tet locator. It writes only those
-  // members (surface_*, collision_, locator_) and reads on_cut_ and scene_, so a pass runs it
-  // on a second thread beside the model update. Times surface_ms, collision_ms, locator_ms.
+  // boundary faces, render surface and FCL hierarchy. It writes only those members
+  // (surface_*, collision_) and reads on_cut_ and scene_, so a pass runs it on a second
+  // thread beside the model update. Times surface_ms, collision_ms. (The tet locator is
+  // rebuildGeometry's, or the pass's background thread's.)
   Status buildGeometry(const cutting::TetMesh& mesh, const sim::NodeVectors& x, PassRecord* timing,
                        const std::vector<std::uint8_t>* boundary);
   // rebuildGeometry's second part, once mesh_, model_ and state_ are the new ones: contact
@@ -190,6 +198,10 @@ class Simulation {
   bool buried_known_ = false;
   bool buried_ = false;
   TetLocator locator_;
+  // The locator's build after a pass (see finishPass); waitLocator() joins it. Everything
+  // that reads locator_ (the buried test, the next pass, rebuildGeometry) waits first.
+  mutable std::thread locator_thread_;
+  void waitLocator() const;
   Eigen::Matrix<double, Eigen::Dynamic, 3> wire_, previous_wire_;
   Sweep sweep_;
   bool loop_in_tissue_ = false;

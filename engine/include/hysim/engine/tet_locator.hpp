@@ -28,16 +28,20 @@ class TetLocator {
   double margin() const { return margin_; }
 
  private:
-  // p lies in tet t at positions x, the nodes having moved at most `moved` since the build.
-  bool contains(const cutting::TetMesh& mesh, const sim::NodeVectors& x, int t, const Eigen::Vector3d& p,
-                double moved) const;
+  // p lies in tet t at positions x.
+  bool containsNow(const cutting::TetMesh& mesh, const sim::NodeVectors& x, int t, const Eigen::Vector3d& p) const;
+
+  struct Entry {  // a cell's tet and its build box (see build())
+    float lo[3], hi[3];
+    int tet;
+  };
 
   Eigen::Vector3d origin_{0, 0, 0};
   double cell_ = 1.0;
   double inv_cell_ = 1.0;  // 1 / cell_
   Eigen::Vector3i dims_{0, 0, 0};
   std::vector<int> cell_start_;  // #cells + 1
-  std::vector<int> cell_tets_;
+  std::vector<Entry> cell_boxes_;  // the cells' tets in increasing order, cell after cell
   std::vector<int> fill_;        // build scratch
   std::vector<Eigen::Vector3i> ranges_;  // build scratch: first and last cell of each tet
   std::vector<double> boxes_;            // 6 #T: each tet's box at the build (min xyz, max xyz)

@@ -1,0 +1,181 @@
+// The engine's per-pass geometry work on dumped pass meshes (hysim run --dump-cuts DIR):
+// boundary faces, face matching, the FCL hierarchy build, the tet locator build, pieces.
+// HYSIM_REPLAY_DIR names the folder (default: skipped). Rest positions stand in for the
+// deformed ones.
+#include <benchmark/benchmark.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+#include "hysim/cutting/cut3d.hpp"
+#include "hysim/cutting/mesh_io.hpp"
+#include "hysim/engine/collision.hpp"
+#include "hysim/engine/mesh_faces.hpp"
+#include "hysim/engine/tet_locator.hpp"
+
+namespace {
+using namespace hysim;
+
+std::vector<cutting::TetMesh>& meshes() {
+  static std::vector<cutting::TetMesh> all;
+  static bool loaded = false;
+  if (loaded) return all;
+  loaded = true;
+  const char* dir = std::getenv("HYSIM_REPLAY_DIR");
+  if (dir == nullptr) return all;
+  for (int p = 1; p < 200; p += 1) {
+    char name[64];
+    std::snprintf(name, sizeof(name), "/pass_%03d_mesh.msh", p);
+    auto m = cutting::readTetMesh(std::string(dir) + name);
+    if (!m.ok()) break;
+    all.push_back(std::move(*m));
+  }
+  return all;
+}
+
+void BM_CollisionBuild(benchmark::State& state) {
+  auto& ms = meshes();
+  if (ms.empty()) return state.SkipWithError("no HYSIM_REPLAY_DIR");
+  std::vector<cutting::Tris> faces;
+  for (auto& m : ms) faces.push_back(cutting::boundaryFaces(m));
+  engine::TissueCollision c;
+  int same = 0;
+  for (size_t i = 0; i < ms.size(); ++i) same += c.build(faces[i], ms[i].X, 0.5).ok() && c.matchesFclBuild();
+  state.counters["same_tree_as_fcl"] = same;
+  state.counters["meshes"] = static_cast<double>(ms.size());
+  for (auto _ : state)
+    for (size_t i = 0; i < ms.size(); ++i) benchmark::DoNotOptimize(c.build(faces[i], ms[i].X, 0.5).ok());
+}
+BENCHMARK(BM_CollisionBuild)->Unit(benchmark::kMillisecond);
+
+void BM_LocatorBuild(benchmark::State& state) {
+  auto& ms = meshes();
+  if (ms.empty()) return state.SkipWithError("no HYSIM_REPLAY_DIR");
+  engine::TetLocator l;
+  for (auto _ : state)
+    for (auto& m : ms) l.build(m, m.X);
+}
+BENCHMARK(BM_LocatorBuild)->Unit(benchmark::kMillisecond);
+
+void BM_MatchPieces(benchmark::State& state) {
+  auto& ms = meshes();
+  if (ms.empty()) return state.SkipWithError("no HYSIM_REPLAY_DIR");
+  std::vector<int> next;
+  for (auto _ : state)
+    for (auto& m : ms) {
+      engine::matchFaces(m, next);
+      std::vector<std::uint8_t> anchored(m.numNodes(), 0);
+      anchored[0] = 1;
+      benchmark::DoNotOptimize(engine::tetPieces(m, next, anchored).count);
+    }
+}
+BENCHMARK(BM_MatchPieces)->Unit(benchmark::kMillisecond);
+
+// The map's point location: each dumped pass's sweep points (rest shape) in its mesh, the
+// locator built at rest, queried with a displacement bound of range(0) / 10 mm.
+void BM_Locate(benchmark::State& state) {
+  struct Pass {
+    cutting::TetMesh mesh;
+    cutting::Positions points;
+    sim::NodeVectors x;
+    engine::TetLocator locator;
+  };
+  static std::vector<Pass> passes = [] {
+    std::vector<Pass> out;
+    const char* dir = std::getenv("HYSIM_REPLAY_DIR");
+    if (dir == nullptr) return out;
+    for (int i = 1;; ++i) {
+      char name[32];
+      std::snprintf(name, sizeof(name), "/pass_%03d_", i);
+      auto m = cutting::readTetMesh(std::string(dir) + name + "mesh.msh");
+      auto tri = cutting::readTriMesh(std::string(dir) + name + "surface.msh");
+      if (!m.ok() || !tri.ok()) break;
+      Pass p;
+      p.mesh = std::move(*m);
+      p.points = tri->X;
+      p.x = p.mesh.X;
+      p.locator.build(p.mesh, p.x);
+      out.push_back(std::move(p));
+    }
+    return out;
+  }();
+  if (passes.empty()) return state.SkipWithError("no HYSIM_REPLAY_DIR");
+  const double moved = static_cast<double>(state.range(0)) / 10.0;
+  long inside = 0, total = 0, sum = 0;
+  for (auto _ : state) {
+    inside = total = sum = 0;
+    for (const Pass& p : passes)
+      for (Eigen::Index i = 0; i < p.points.rows(); ++i) {
+        const int t = p.locator.locate(p.mesh, p.x, p.points.row(i).transpose(), moved);
+        inside += t >= 0;
+        sum += t;
+        ++total;
+      }
+  }
+  state.counters["inside"] = static_cast<double>(inside);
+  state.counters["points"] = static_cast<double>(total);
+  state.counters["tet_sum"] = static_cast<double>(sum);
+}
+BENCHMARK(BM_Locate)->Arg(0)->Arg(5)->Arg(10)->Unit(benchmark::kMillisecond);
+
+// updateFaces + tetPieces after each dumped pass's hybrid cut (as Simulation::finishPass).
+void BM_FacesPieces(benchmark::State& state) {
+  struct Pass {
+    cutting::TetMesh before, after;
+    cutting::TopologyChange change;
+    std::vector<int> next_before;
+    std::vector<std::uint8_t> anchored;
+  };
+  static std::vector<Pass> passes = [] {
+    std::vector<Pass> out;
+    const char* dir = std::getenv("HYSIM_REPLAY_DIR");
+    if (dir == nullptr) return out;
+    for (int i = 1;; ++i) {
+      char name[32];
+      std::snprintf(name, sizeof(name), "/pass_%03d_", i);
+      auto m = cutting::readTetMesh(std::string(dir) + name + "mesh.msh");
+      auto tri = cutting::readTriMesh(std::string(dir) + name + "surface.msh");
+      if (!m.ok() || !tri.ok()) break;
+      auto s = cutting::CutSurface::triangles(tri->X, tri->F);
+      if (!s.ok()) break;
+      cutting::Cut3DOptions o;
+      o.method = cutting::CutMethod::Hybrid;
+      auto r = cutting::cut3d(*m, *s, o);
+      if (!r.ok()) break;
+      Pass p;
+      p.before = std::move(*m);
+      p.after = std::move(r->mesh);
+      p.change = std::move(r->change);
+      engine::matchFaces(p.before, p.next_before);
+      p.anchored.assign(static_cast<size_t>(p.after.numNodes()), 0);
+      for (int n = 0; n < p.after.numNodes(); ++n) {
+        const Eigen::Vector3d x = p.after.X.row(n).transpose();
+        p.anchored[n] = (x.array() / Eigen::Array3d(25, 20, 33)).matrix().squaredNorm() > 1.0;
+      }
+      out.push_back(std::move(p));
+    }
+    return out;
+  }();
+  if (passes.empty()) return state.SkipWithError("no HYSIM_REPLAY_DIR");
+  std::vector<int> next;
+  int chips = 0;
+  for (auto _ : state) {
+    chips = 0;
+    for (const Pass& p : passes) {
+      if (!engine::updateFaces(p.before, p.next_before, p.after, p.change.node_old_to_new,
+                               p.change.element_old_to_new, next)) {
+        return state.SkipWithError("updateFaces failed");
+      }
+      const engine::Pieces c = engine::tetPieces(p.after, next, p.anchored);
+      for (int k = 0; k < c.count; ++k) chips += c.free[k];
+    }
+  }
+  state.counters["chips"] = chips;
+  state.counters["passes"] = static_cast<double>(passes.size());
+}
+BENCHMARK(BM_FacesPieces)->Unit(benchmark::kMillisecond);
+
+}  // namespace
+BENCHMARK_MAIN();
