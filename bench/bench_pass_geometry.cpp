@@ -41,9 +41,6 @@ void BM_CollisionBuild(benchmark::State& state) {
   std::vector<cutting::Tris> faces;
   for (auto& m : ms) faces.push_back(cutting::boundaryFaces(m));
   engine::TissueCollision c;
-  int same = 0;
-  for (size_t i = 0; i < ms.size(); ++i) same += c.build(faces[i], ms[i].X, 0.5).ok() && c.matchesFclBuild();
-  state.counters["same_tree_as_fcl"] = same;
   state.counters["meshes"] = static_cast<double>(ms.size());
   for (auto _ : state)
     for (size_t i = 0; i < ms.size(); ++i) benchmark::DoNotOptimize(c.build(faces[i], ms[i].X, 0.5).ok());

@@ -9,7 +9,6 @@
 
 #include <algorithm>
 #include <array>
-#include <limits>
 #include <vector>
 
 namespace hysim::engine {
@@ -73,173 +72,123 @@ void SweptWire::triangle(int t, Eigen::Vector3d& a, Eigen::Vector3d& b, Eigen::V
 }
 
 // ---------------------------------------------------------------------------------------
-// The tissue hierarchy is built here rather than by FCL's BVHModel::endModel, which reads
-// each triangle's vertices through FCL's generic fitter and splitter (virtual calls, and
-// fcl::Triangle::operator[] out of line in libfcl) at every level: that was ~1.4 ms of a
-// pass's ~1.5 ms collision build. TreeBuilder makes the same tree as endModel with FCL's
-// SPLIT_METHOD_MEAN for AABB (node numbering, primitive order, boxes): fit the node's box to
-// its triangles, split at the mean of their centroids along the box's longest axis (x, then
-// y on ties), centroid > mean to the right, an empty side replaced by halving; left child
-// first. Per-triangle boxes, coordinate sums and centroids are computed once, with the same
-// sums in the same order as FCL, so every comparison gives the same answer
-// (TissueCollision::matchesFclBuild checks the whole tree against endModel's).
-struct BvhWriter {};
-
-}  // namespace hysim::engine
-
-namespace fcl {
-// BVHModel befriends every specialisation of MakeParentRelativeRecurseImpl; this one (for a
-// tag type of ours, which FCL never instantiates) is how the builder below writes the
-// model's private tree arrays (bvs, primitive_indices, num_bvs).
-template <>
-struct MakeParentRelativeRecurseImpl<double, hysim::engine::BvhWriter> {
-  static BVNode<AABBd>* nodes(BVHModel<AABBd>& m) { return m.bvs; }
-  static unsigned int* primitives(BVHModel<AABBd>& m) { return m.primitive_indices; }
-  // Allocates the tree arrays of a model that beginModel + addSubModel filled (what
-  // endModel would allocate), before the builder writes them.
-  static void allocate(BVHModel<AABBd>& m) {
-    const int n = 2 * m.num_tris - 1;
-    m.bvs = new BVNode<AABBd>[static_cast<size_t>(n)];
-    m.primitive_indices = new unsigned int[static_cast<size_t>(n)];
-    m.num_bvs_allocated = n;
-    m.num_bvs = 0;
-  }
-  static void finish(BVHModel<AABBd>& m, int num_bvs) {
-    m.num_bvs = num_bvs;
-    m.build_state = BVH_BUILD_STATE_PROCESSED;
-  }
-};
-}  // namespace fcl
-
-namespace hysim::engine {
-namespace {
-
-using BvhAccess = fcl::MakeParentRelativeRecurseImpl<double, BvhWriter>;
-
-class TreeBuilder {
+// FCL's build of an AABB tree (BVHModel::endModel: fit the node's box, split at the mean of
+// its triangles' centroids along the box's longest axis, recurse) reads each triangle's three
+// vertices through FCL's generic fitter and splitter at every level. These two give the same
+// boxes and split rules (the same sums in the same order, so the same tree) from per-triangle
+// boxes and coordinate sums computed once when the build starts.
+class TriangleBoxes {
  public:
-  // Builds the tree of `bvh` (after beginModel + addSubModel with its triangles). parent
-  // (#BV) and leaf_of_tri (#F) receive each node's parent and each triangle's leaf.
-  void build(Bvh& bvh, std::vector<int>& parent, std::vector<int>& leaf_of_tri) {
-    const int nt = bvh.num_tris;
-    tris_.resize(static_cast<size_t>(nt));
-    const fcl::Vector3d* v = bvh.vertices;
-    fcl::Vector3d lo = fcl::Vector3d::Constant(std::numeric_limits<double>::max());  // FCL's empty box
-    fcl::Vector3d hi = fcl::Vector3d::Constant(-std::numeric_limits<double>::max());
-    for (int t = 0; t < nt; ++t) {
-      const fcl::Triangle& tri = bvh.tri_indices[t];
-      const fcl::Vector3d &a = v[tri[0]], &b = v[tri[1]], &c = v[tri[2]];
-      Tri& d = tris_[static_cast<size_t>(t)];
-      for (int k = 0; k < 3; ++k) {
-        d.lo[k] = std::min(std::min(a[k], b[k]), c[k]);
-        d.hi[k] = std::max(std::max(a[k], b[k]), c[k]);
-        d.sum[k] = a[k] + b[k] + c[k];  // as FCL's mean rule adds them
-        d.centroid[k] = d.sum[k] / 3.0;  // as recursiveBuildTree's (p1 + p2 + p3) / 3.0
-        lo[k] = std::min(lo[k], d.lo[k]);
-        hi[k] = std::max(hi[k], d.hi[k]);
-      }
+  void set(const fcl::Vector3d* vertices, const fcl::Triangle* tris, int num_tris) {
+    lo_.resize(static_cast<size_t>(num_tris));
+    hi_.resize(static_cast<size_t>(num_tris));
+    sum_.resize(static_cast<size_t>(num_tris));
+    for (int t = 0; t < num_tris; ++t) {
+      const fcl::Vector3d &a = vertices[tris[t][0]], &b = vertices[tris[t][1]], &c = vertices[tris[t][2]];
+      lo_[t] = a.cwiseMin(b).cwiseMin(c);
+      hi_[t] = a.cwiseMax(b).cwiseMax(c);
+      for (int k = 0; k < 3; ++k) sum_[t][k] = a[k] + b[k] + c[k];  // as FCL's mean rule adds them
     }
-    BvhAccess::allocate(bvh);
-    nodes_ = BvhAccess::nodes(bvh);
-    prims_ = BvhAccess::primitives(bvh);
-    for (int i = 0; i < nt; ++i) prims_[i] = static_cast<unsigned int>(i);
-    parent.assign(2 * static_cast<size_t>(nt) - 1, -1);
-    leaf_of_tri.assign(static_cast<size_t>(nt), -1);
-    parent_ = parent.data();
-    leaf_of_tri_ = leaf_of_tri.data();
-    num_bvs_ = 1;
-    recurse(0, 0, nt, lo, hi);
-    BvhAccess::finish(bvh, num_bvs_);
+  }
+  void clear() {
+    lo_.clear();
+    hi_.clear();
+    sum_.clear();
+  }
+  std::vector<fcl::Vector3d> lo_, hi_, sum_;
+};
+
+class BoxFitter final : public fcl::detail::BVFitterBase<fcl::AABBd> {
+ public:
+  explicit BoxFitter(std::shared_ptr<TriangleBoxes> boxes) : boxes_(std::move(boxes)) {}
+  void set(fcl::Vector3d* vertices, fcl::Triangle* tris, fcl::BVHModelType type) override {
+    type_ = type;
+    vertices_ = vertices;
+    tris_ = tris;
+  }
+  void set(fcl::Vector3d* vertices, fcl::Vector3d* prev, fcl::Triangle* tris, fcl::BVHModelType type) override {
+    set(vertices, tris, type);
+    prev_ = prev;
+  }
+  fcl::AABBd fit(unsigned int* primitives, int count) override {
+    fcl::AABBd box;  // empty: +max / -max, as FCL's fitter starts
+    const TriangleBoxes& b = *boxes_;
+    if (type_ != fcl::BVH_MODEL_TRIANGLES || prev_ != nullptr || b.lo_.empty()) {
+      // Outside a build (FCL's top-down refit): FCL's own rule over the vertices.
+      for (int i = 0; i < count; ++i) {
+        const unsigned int p = primitives[i];
+        if (type_ == fcl::BVH_MODEL_TRIANGLES) {
+          for (int k = 0; k < 3; ++k) {
+            box += vertices_[tris_[p][k]];
+            if (prev_ != nullptr) box += prev_[tris_[p][k]];
+          }
+        } else {
+          box += vertices_[p];
+          if (prev_ != nullptr) box += prev_[p];
+        }
+      }
+      return box;
+    }
+    for (int i = 0; i < count; ++i) {
+      box.min_ = box.min_.cwiseMin(b.lo_[primitives[i]]);
+      box.max_ = box.max_.cwiseMax(b.hi_[primitives[i]]);
+    }
+    return box;
+  }
+  void clear() override {
+    vertices_ = nullptr;
+    prev_ = nullptr;
+    tris_ = nullptr;
   }
 
  private:
-  struct Tri {
-    double lo[3], hi[3], sum[3], centroid[3];  // box, coordinate sums, sums / 3.0
-  };
-
-  // Node `id` over prims_[first, first + count), whose triangles' boxes span [lo, hi] (a box
-  // is a min/max, the same in any order: the parent's partition gathers the children's).
-  void recurse(int id, int first, int count, const fcl::Vector3d& lo, const fcl::Vector3d& hi) {
-    unsigned int* const prims = prims_ + first;
-    fcl::BVNode<fcl::AABBd>& node = nodes_[id];
-    node.bv.min_ = lo;
-    node.bv.max_ = hi;
-    node.first_primitive = first;
-    node.num_primitives = count;
-    if (count == 1) {
-      node.first_child = -static_cast<int>(prims[0]) - 1;
-      leaf_of_tri_[prims[0]] = id;
-      return;
-    }
-    const double w = hi[0] - lo[0], h = hi[1] - lo[1], d = hi[2] - lo[2];
-    int axis = 2;
-    if (w >= h && w >= d) {
-      axis = 0;
-    } else if (h >= w && h >= d) {
-      axis = 1;
-    }
-    const Tri* const tris = tris_.data();
-    double sum = 0;
-    for (int i = 0; i < count; ++i) sum += tris[prims[i]].sum[axis];
-    sum /= 3;
-    const double value = sum / count;
-    const int left = num_bvs_;
-    node.first_child = left;
-    num_bvs_ += 2;
-    parent_[left] = id;
-    parent_[left + 1] = id;
-    // FCL's partition (centroid (p1 + p2 + p3) / 3.0 > mean: right), the children's boxes on the way.
-    // Without branches (the side is a coin toss for the predictor): a triangle going left
-    // swaps with the first one on the right (a no-op otherwise).
-    constexpr double kMax = std::numeric_limits<double>::max();
-    double llo[3] = {kMax, kMax, kMax}, lhi[3] = {-kMax, -kMax, -kMax};
-    double rlo[3] = {kMax, kMax, kMax}, rhi[3] = {-kMax, -kMax, -kMax};
-    int c1 = 0;
-    for (int i = 0; i < count; ++i) {
-      const unsigned int p = prims[i];
-      const Tri& t = tris[p];
-      const bool right = t.centroid[axis] > value;
-      for (int k = 0; k < 3; ++k) {
-        llo[k] = std::min(llo[k], right ? kMax : t.lo[k]);
-        lhi[k] = std::max(lhi[k], right ? -kMax : t.hi[k]);
-        rlo[k] = std::min(rlo[k], right ? t.lo[k] : kMax);
-        rhi[k] = std::max(rhi[k], right ? t.hi[k] : -kMax);
-      }
-      const unsigned int q = prims[c1];
-      prims[i] = right ? p : q;
-      prims[c1] = right ? q : p;
-      c1 += right ? 0 : 1;
-    }
-    if (c1 == 0 || c1 == count) {  // all on one side: halves, boxes refitted
-      c1 = count / 2;
-      for (int k = 0; k < 3; ++k) {
-        llo[k] = rlo[k] = kMax;
-        lhi[k] = rhi[k] = -kMax;
-      }
-      for (int i = 0; i < count; ++i) {
-        const Tri& t = tris[prims[i]];
-        double* const a = i < c1 ? llo : rlo;
-        double* const b = i < c1 ? lhi : rhi;
-        for (int k = 0; k < 3; ++k) {
-          a[k] = std::min(a[k], t.lo[k]);
-          b[k] = std::max(b[k], t.hi[k]);
-        }
-      }
-    }
-    recurse(left, first, c1, fcl::Vector3d(llo[0], llo[1], llo[2]), fcl::Vector3d(lhi[0], lhi[1], lhi[2]));
-    recurse(left + 1, first + c1, count - c1, fcl::Vector3d(rlo[0], rlo[1], rlo[2]),
-            fcl::Vector3d(rhi[0], rhi[1], rhi[2]));
-  }
-
-  std::vector<Tri> tris_;
-  fcl::BVNode<fcl::AABBd>* nodes_ = nullptr;
-  unsigned int* prims_ = nullptr;
-  int* parent_ = nullptr;
-  int* leaf_of_tri_ = nullptr;
-  int num_bvs_ = 0;
+  std::shared_ptr<TriangleBoxes> boxes_;
+  fcl::BVHModelType type_ = fcl::BVH_MODEL_UNKNOWN;
+  fcl::Vector3d* vertices_ = nullptr;
+  fcl::Vector3d* prev_ = nullptr;
+  fcl::Triangle* tris_ = nullptr;
 };
 
-}  // namespace
+class MeanSplitter final : public fcl::detail::BVSplitterBase<fcl::AABBd> {
+ public:
+  explicit MeanSplitter(std::shared_ptr<TriangleBoxes> boxes) : boxes_(std::move(boxes)) {}
+  void set(fcl::Vector3d* vertices, fcl::Triangle* tris, fcl::BVHModelType type) override {
+    type_ = type;
+    vertices_ = vertices;
+    if (type == fcl::BVH_MODEL_TRIANGLES) boxes_->set(vertices, tris, num_tris_);
+  }
+  void setNumTriangles(int n) { num_tris_ = n; }
+  void computeRule(const fcl::AABBd& bv, unsigned int* primitives, int count) override {
+    // FCL's SPLIT_METHOD_MEAN for AABB: the longest axis (x, then y on ties), the mean of
+    // the centroids' coordinates along it.
+    int axis = 2;
+    if (bv.width() >= bv.height() && bv.width() >= bv.depth()) {
+      axis = 0;
+    } else if (bv.height() >= bv.width() && bv.height() >= bv.depth()) {
+      axis = 1;
+    }
+    axis_ = axis;
+    double sum = 0;
+    if (type_ == fcl::BVH_MODEL_TRIANGLES) {
+      const std::vector<fcl::Vector3d>& s = boxes_->sum_;
+      for (int i = 0; i < count; ++i) sum += s[primitives[i]][axis];
+      sum /= 3;
+    } else {
+      for (int i = 0; i < count; ++i) sum += vertices_[primitives[i]][axis];
+    }
+    value_ = sum / count;
+  }
+  bool apply(const fcl::Vector3d& q) const override { return q[axis_] > value_; }
+  void clear() override { boxes_->clear(); }
+
+ private:
+  std::shared_ptr<TriangleBoxes> boxes_;
+  fcl::BVHModelType type_ = fcl::BVH_MODEL_UNKNOWN;
+  fcl::Vector3d* vertices_ = nullptr;
+  int num_tris_ = 0;
+  int axis_ = 0;
+  double value_ = 0.0;
+};
 
 // ---------------------------------------------------------------------------------------
 struct TissueCollision::Impl {
@@ -325,15 +274,37 @@ Status TissueCollision::build(const cutting::Tris& faces, const sim::NodeVectors
   std::vector<fcl::Vector3d> vertices(impl_->nodes.size());
   for (size_t i = 0; i < impl_->nodes.size(); ++i) vertices[i] = x.row(impl_->nodes[i]).transpose();
   auto bvh = std::make_shared<Bvh>();
-  Impl& m = *impl_;
+  {
+    auto boxes = std::make_shared<TriangleBoxes>();
+    auto splitter = std::make_shared<MeanSplitter>(boxes);
+    splitter->setNumTriangles(static_cast<int>(triangles.size()));
+    bvh->bv_splitter = splitter;
+    bvh->bv_fitter = std::make_shared<BoxFitter>(boxes);
+  }
   if (bvh->beginModel(static_cast<int>(triangles.size()), static_cast<int>(vertices.size())) != fcl::BVH_OK ||
-      bvh->addSubModel(vertices, triangles) != fcl::BVH_OK) {
+      bvh->addSubModel(vertices, triangles) != fcl::BVH_OK || bvh->endModel() != fcl::BVH_OK) {
     impl_->nodes.clear();
     return Error{"collision: cannot build the tissue's bounding volume hierarchy"};
   }
-  // endModel's tree (see TreeBuilder), children numbered after their parent.
-  TreeBuilder().build(*bvh, m.parent, m.leaf_of_tri);
-  m.children_after_parents = true;
+  impl_->children_after_parents = true;
+  for (int b = 0; b < bvh->getNumBVs(); ++b) {
+    const fcl::BVNode<fcl::AABBd>& n = bvh->getBV(b);
+    if (!n.isLeaf() && (n.leftChild() <= b || n.rightChild() <= b || n.rightChild() >= bvh->getNumBVs())) {
+      impl_->children_after_parents = false;
+    }
+  }
+  Impl& m = *impl_;
+  m.parent.assign(static_cast<size_t>(bvh->getNumBVs()), -1);
+  m.leaf_of_tri.assign(triangles.size(), -1);
+  for (int b = 0; b < bvh->getNumBVs(); ++b) {
+    const fcl::BVNode<fcl::AABBd>& n = bvh->getBV(b);
+    if (n.isLeaf()) {
+      m.leaf_of_tri[static_cast<size_t>(n.primitiveId())] = b;
+    } else if (m.children_after_parents) {
+      m.parent[static_cast<size_t>(n.leftChild())] = b;
+      m.parent[static_cast<size_t>(n.rightChild())] = b;
+    }
+  }
   m.vtx_start.assign(m.nodes.size() + 1, 0);
   for (const fcl::Triangle& t : triangles)
     for (int c = 0; c < 3; ++c) ++m.vtx_start[t[c] + 1];
@@ -347,32 +318,6 @@ Status TissueCollision::build(const cutting::Tris& faces, const sim::NodeVectors
   impl_->refit_x = std::move(vertices);
   refit(x);  // grow the boxes by the margin
   return Status::Ok();
-}
-
-bool TissueCollision::matchesFclBuild() const {
-  const Bvh* mine = impl_->bvh.get();
-  if (mine == nullptr) return impl_->num_faces == 0;
-  // FCL's own build of the same triangles at the same vertices (where the boxes were fitted).
-  Bvh fcl_model;  // default: BVFitter, BVSplitter with SPLIT_METHOD_MEAN
-  std::vector<fcl::Vector3d> vertices(impl_->refit_x.begin(), impl_->refit_x.end());
-  std::vector<fcl::Triangle> triangles(mine->tri_indices, mine->tri_indices + mine->num_tris);
-  if (fcl_model.beginModel(mine->num_tris, mine->num_vertices) != fcl::BVH_OK ||
-      fcl_model.addSubModel(vertices, triangles) != fcl::BVH_OK || fcl_model.endModel() != fcl::BVH_OK) {
-    return false;
-  }
-  if (fcl_model.getNumBVs() != mine->getNumBVs()) return false;
-  Bvh& a = const_cast<Bvh&>(*mine);
-  for (int b = 0; b < fcl_model.getNumBVs(); ++b) {
-    const fcl::BVNode<fcl::AABBd>& p = fcl_model.getBV(b);
-    const fcl::BVNode<fcl::AABBd>& q = a.getBV(b);
-    if (p.first_child != q.first_child || p.first_primitive != q.first_primitive ||
-        p.num_primitives != q.num_primitives) {
-      return false;
-    }
-  }
-  const unsigned int* pa = BvhAccess::primitives(fcl_model);
-  const unsigned int* pb = BvhAccess::primitives(a);
-  return std::equal(pa, pa + mine->num_tris, pb);
 }
 
 void TissueCollision::refit(const sim::NodeVectors& x) {

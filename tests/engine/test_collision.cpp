@@ -85,38 +85,6 @@ TEST(Collision, BoundaryHierarchyOfASlab) {
 }
 
 // Lower the loop through the slab in 0.05 mm steps: the swept wire touches the top face on
-
-// build() makes the hierarchy itself (not through FCL's BVHModel::endModel); it must be the
-// very tree endModel builds: a slab (many ties in the split rule), a jittered slab, all tet
-// faces, and a random triangle soup.
-TEST(Collision, TheHierarchyIsFclsOwnTree) {
-  cutting::TetMesh mesh = slab();
-  TissueCollision c;
-  ASSERT_TRUE(c.build(cutting::boundaryFaces(mesh), mesh.X, 0.5).ok());
-  EXPECT_TRUE(c.matchesFclBuild());
-  ASSERT_TRUE(c.build(allTetFaces(mesh), mesh.X, 0.0).ok());
-  EXPECT_TRUE(c.matchesFclBuild());
-  std::mt19937 rng(7);
-  std::uniform_real_distribution<double> jitter(-0.3, 0.3);
-  for (int i = 0; i < mesh.numNodes(); ++i)
-    for (int k = 0; k < 3; ++k) mesh.X(i, k) += jitter(rng);
-  ASSERT_TRUE(c.build(cutting::boundaryFaces(mesh), mesh.X, 0.5).ok());
-  EXPECT_TRUE(c.matchesFclBuild());
-  std::uniform_real_distribution<double> where(-10.0, 10.0);
-  std::uniform_int_distribution<int> node(0, 199);
-  sim::NodeVectors x(200, 3);
-  for (int i = 0; i < 200; ++i)
-    for (int k = 0; k < 3; ++k) x(i, k) = where(rng);
-  cutting::Tris soup(500, 3);
-  for (int f = 0; f < 500; ++f) soup.row(f) << node(rng), node(rng), node(rng);
-  ASSERT_TRUE(c.build(soup, x, 0.1).ok());
-  EXPECT_TRUE(c.matchesFclBuild());
-  cutting::Tris one(1, 3);
-  one << 0, 1, 2;
-  ASSERT_TRUE(c.build(one, x, 0.1).ok());
-  EXPECT_TRUE(c.matchesFclBuild());
-}
-
 // the way in and the bottom face on the way out, and nothing of the surface while inside.
 TEST(Collision, SweptWireTouchesTheSurfaceOnEntryAndExit) {
   const cutting::TetMesh mesh = slab();

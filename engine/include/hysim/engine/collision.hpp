@@ -101,10 +101,6 @@ class TissueCollision {
   double margin() const;
   long numRefits() const;       // full refits since construction (build included)
   long numLocalRefits() const;  // vertices refitted locally by update()
-  // For tests: the hierarchy has exactly the tree FCL's BVHModel::endModel builds for the
-  // same triangles at the positions of the last build or refit (nodes, their numbering and
-  // primitive ranges, primitive order). build() makes it without FCL's generic builder.
-  bool matchesFclBuild() const;
 
  private:
   struct Impl;
