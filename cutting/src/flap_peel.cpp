@@ -27,8 +27,9 @@
 //    loops) the hole is opened to the boundary along the shortest chain of tets around the
 //    node (at most 4), or else the flap keeps its tets there unless the worst tet is among them;
 //  - the group is no bridge between two large parts: the tets next to it stay connected
-//    (walks of at most 256 tets); a closed piece that hung on the group only (a chip the
-//    sweep almost cut off, held by a neck this thin) is freed, as the cut frees chips.
+//    (the first walk into a large part stops at 256 tets, the others go on until they meet
+//    an earlier walk); a closed piece of fewer than 256 tets that hung on the group only (a
+//    chip the sweep almost cut off, held by a neck this thin) is freed, as the cut frees chips.
 // Local: it works on the optimiser's node -> tet lists and touches only the tets around the seeds.
 #include "flap_peel.hpp"
 
@@ -493,11 +494,15 @@ void peelFlaps(const TetMesh& mesh, const CutRegion& region, const std::vector<s
         }
       std::sort(rim.begin(), rim.end());
       rim.erase(std::unique(rim.begin(), rim.end()), rim.end());
-      // Walk from each rim tet through the live tets (at most kCap of them): the rim tets
-      // one walk reaches are connected; a walk that ends before kCap has found a closed piece
-      // that hung on the group only (a chip the sweep almost cut off, held by a neck thinner
-      // than the flap): it is freed, as the cut frees chips. Two walks that both reach kCap
-      // without meeting: the group is a bridge between large parts; refused.
+      // Walk from each rim tet through the live tets: the rim tets one walk reaches are
+      // connected. The first walk into a large part stops at kCap tets; a later walk that
+      // reaches a tet of an earlier walk is connected to it (to the large part: a walk that
+      // ended by itself covered its whole piece) and stops there. A later walk that ends by
+      // itself before kCap tets has found a closed piece that hung on the group only (a chip
+      // the sweep almost cut off, held by a neck thinner than the flap): it is freed, as the
+      // cut frees chips. A later walk that passes kCap goes on until it meets an earlier
+      // walk (the rim tets are connected around a longer way: no bridge) or ends by itself
+      // (a second large part: the group is a bridge between large parts; refused).
       constexpr int kCap = 256;
       if (rim.size() > 1) {
         if (mark.empty()) mark.assign(M, -1);
@@ -506,15 +511,20 @@ void peelFlaps(const TetMesh& mesh, const CutRegion& region, const std::vector<s
           if (mark[rim[r]] >= 0) continue;
           walked.assign(1, rim[r]);
           mark[rim[r]] = static_cast<int>(r);
-          for (size_t i = 0; i < walked.size() && static_cast<int>(walked.size()) < kCap; ++i)
+          bool met = false;
+          for (size_t i = 0; i < walked.size() && !met && (big > 0 || static_cast<int>(walked.size()) < kCap); ++i)
             for (int f = 0; f < 4; ++f) {
               const int u = across(walked[i], f);
-              if (u >= 0 && mark[u] < 0) {
+              if (u < 0) continue;
+              if (mark[u] < 0) {
                 mark[u] = static_cast<int>(r);
                 walked.push_back(u);
+              } else if (mark[u] != static_cast<int>(r)) {
+                met = true;
               }
             }
           allWalked.insert(allWalked.end(), walked.begin(), walked.end());
+          if (met) continue;
           if (static_cast<int>(walked.size()) >= kCap) {
             ok = ++big <= 1;
             continue;

@@ -228,5 +228,21 @@ TEST(ShaveQuality, ACollapseNextToANodeAlreadyPinchedBeforeThePassIsKept) {
   EXPECT_GT(p.out.report.collapsed_edges, 0);
   expectFlapCaseAccepted("pass52", p);
 }
+// Passes 49 and 50 of a default-scene-like run (`hysim run ... --dump-cuts DIR` with a
+// different mapping of the sweep, another branch, 2026-11): each leaves one tet (q* 0.0255,
+// 0.0158) with two boundary faces whose opposite edge is on the boundary too, so removing it
+// alone pinches that edge; its flap group grows to 10 (3) tets with the pieces it cuts off.
+// The bridge check's walks stopped at 256 tets each without noticing that the second one had
+// reached the first one's tets (connected), so the group was refused as a bridge between
+// large parts and q*_min stayed at 0.24x (0.15x). A later walk now stops where it meets an
+// earlier one (and goes past 256 tets until it does or ends by itself).
+TEST(ShaveQuality, AFlapWhoseRimIsConnectedBeyondTheFirstWalkIsNoBridge) {
+  for (const std::string name : {"pass49", "pass50"}) {
+    DumpedPass p;
+    ASSERT_TRUE(cutDumpedPass(name, Cut3DOptions{}, &p));
+    EXPECT_GT(p.out.report.flap_peeled, 0) << name;
+    expectFlapCaseAccepted(name, p);
+  }
+}
 }  // namespace
 }  // namespace hysim::cutting
