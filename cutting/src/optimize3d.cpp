@@ -167,11 +167,23 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   VolumeBudget moveBudget{meshVolume * options.move_volume_budget, churnFactor};
   const double refVolume = curved && options.collapse_volume_fraction_of_edge_tet ? edgeTet : 0.0;
   auto pos = [&](int i) -> Vec3 { return mesh.X.row(i).transpose(); };
-  // q* of tet t, cached per tet with the node indices and positions it was computed from
-  // (a hit needs all of them unchanged, so the value is exactly what radiusRatio returns).
+  // q* of tet t, cached per tet with the node indices and the nodes' versions it was computed
+  // from (nodeVer[n] counts the writes of n's position here; a hit needs the same nodes, none
+  // moved since, so the value is exactly what radiusRatio returns).
+  // (Each write takes a new number; restorePos puts back a position and the number it had.)
+  std::vector<std::uint32_t> nodeVer(N, 0);
+  std::uint32_t verClock = 0;
+  auto setPos = [&](int n, const Vec3& x) {
+    mesh.X.row(n) = x.transpose();
+    nodeVer[n] = ++verClock;
+  };
+  auto restorePos = [&](int n, const Vec3& x, std::uint32_t ver) {
+    mesh.X.row(n) = x.transpose();
+    nodeVer[n] = ver;
+  };
   struct QEntry {
     std::int32_t v[4];
-    double x[12];
+    std::uint32_t ver[4];
     double q;
   };
   std::vector<std::int32_t> qSlot(M, -1);
@@ -180,12 +192,12 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     QEntry cur;
     for (int k = 0; k < 4; ++k) {
       cur.v[k] = mesh.T(t, k);
-      for (int a = 0; a < 3; ++a) cur.x[3 * k + a] = mesh.X(cur.v[k], a);
+      cur.ver[k] = nodeVer[cur.v[k]];
     }
     std::int32_t& slot = qSlot[t];
     if (slot >= 0) {
       const QEntry& e = qPool[slot];
-      if (std::equal(cur.v, cur.v + 4, e.v) && std::equal(cur.x, cur.x + 12, e.x)) return e.q;
+      if (std::equal(cur.v, cur.v + 4, e.v) && std::equal(cur.ver, cur.ver + 4, e.ver)) return e.q;
     } else {
       slot = static_cast<std::int32_t>(qPool.size());
       qPool.emplace_back();
@@ -405,74 +417,92 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   // Is the neighbourhood of v (tets `around`) manifold: every face used by at most two tets,
   // and the boundary faces around v one closed loop (or none: interior)? No tets: the node
   // goes away (compacted), which is fine.
-  auto discAround = [&](int v, const std::vector<std::int32_t>& around) {
+  // linkOnly: only fill `link` (the boundary edges around v, up to the first face used by
+  // more than two tets) and return whether the faces are; the loop check is skipped.
+  std::vector<std::int32_t> linkDeg, linkInc, tetLocal;
+  std::vector<std::uint16_t> faceUses;
+  auto discAround = [&](int v, const std::vector<std::int32_t>& around, bool linkOnly = false) {
     link.clear();
     if (around.empty()) return true;
     // Every tet of `around` has v; a face (v, a, b) is used by the tets with both a and b:
     // count the pairs of each tet's other three nodes in a table over v's neighbours.
+    // Each tet's nodes as local numbers (-1: v), read from the mesh once.
     nbrs.clear();
-    for (int t : around)
+    tetLocal.resize(4 * around.size());
+    for (size_t i = 0; i < around.size(); ++i)
       for (int k = 0; k < 4; ++k) {
-        const int w = mesh.T(t, k);
-        if (w != v && localId[w] < 0) {
+        const int w = mesh.T(around[i], k);
+        if (w == v) {
+          tetLocal[4 * i + k] = -1;
+          continue;
+        }
+        if (localId[w] < 0) {
           localId[w] = static_cast<std::int32_t>(nbrs.size());
           nbrs.push_back(w);
         }
+        tetLocal[4 * i + k] = localId[w];
       }
     const size_t L = nbrs.size();
-    pairCount.assign(L * L, 0);
-    for (int t : around) {
+    faceUses.assign(L * L, 0);
+    for (size_t i = 0; i < around.size(); ++i) {
       std::int32_t o[3], m = 0;
       for (int k = 0; k < 4; ++k)
-        if (mesh.T(t, k) != v && m < 3) o[m++] = localId[mesh.T(t, k)];
-      for (int i = 0; i < m; ++i)
-        for (int j = i + 1; j < m; ++j) ++pairCount[std::min(o[i], o[j]) * L + std::max(o[i], o[j])];
+        if (tetLocal[4 * i + k] >= 0 && m < 3) o[m++] = tetLocal[4 * i + k];
+      for (int a = 0; a < m; ++a)
+        for (int b = a + 1; b < m; ++b) ++faceUses[std::min(o[a], o[b]) * L + std::max(o[a], o[b])];
     }
     bool manifold = true;
     for (size_t i = 0; i < around.size() && manifold; ++i) {
-      const int t = around[i];
+      const std::int32_t* tl = &tetLocal[4 * i];
       int lv = 0;
-      while (mesh.T(t, lv) != v) ++lv;
+      while (tl[lv] >= 0) ++lv;
+      // The faces f != lv in order; face f at v: the two nodes other than f and lv.
       for (int f = 0; f < 4; ++f) {
         if (f == lv) continue;
         std::int32_t o[2], m = 0;
-        for (int k = 0; k < 3; ++k)
-          if (mesh.T(t, kFace[f][k]) != v) o[m++] = mesh.T(t, kFace[f][k]);
-        const std::int32_t a = localId[o[0]], b = localId[o[1]];
-        const int uses = pairCount[std::min(a, b) * L + std::max(a, b)];
+        for (int k = 0; k < 4; ++k)
+          if (k != f && k != lv) o[m++] = tl[k];
+        const std::uint16_t uses = faceUses[std::min(o[0], o[1]) * L + std::max(o[0], o[1])];
         if (uses > 2) {
           manifold = false;
           break;
         }
         if (uses == 1) {
-          link.push_back(o[0]);
-          link.push_back(o[1]);
+          link.push_back(nbrs[o[0]]);
+          link.push_back(nbrs[o[1]]);
         }
       }
     }
-    for (int w : nbrs) localId[w] = -1;
-    if (!manifold) return false;
-    if (link.empty()) return true;  // interior node
-    // One closed loop: every link vertex has degree 2, and walking from one edge visits all.
-    const size_t edges = link.size() / 2;
-    for (size_t i = 0; i < link.size(); ++i) {
-      int degree = 0;
-      for (size_t j = 0; j < link.size(); ++j) degree += link[j] == link[i];
-      if (degree != 2) return false;
+    if (!manifold || link.empty() || linkOnly) {
+      for (int w : nbrs) localId[w] = -1;
+      return manifold;  // (link.empty(): an interior node)
     }
+    // One closed loop: every link vertex has degree 2, and walking from one edge visits all.
+    // Each link vertex's (first two) edges in a table over v's neighbours: with all degrees 2
+    // the walk from edge 0 leaves each vertex by its other edge, and it visits all edges iff
+    // they form one loop.
+    const size_t edges = link.size() / 2;
+    linkDeg.assign(L, 0);
+    linkInc.resize(2 * L);
+    for (size_t i = 0; i < link.size(); ++i) {
+      const std::int32_t id = localId[link[i]];
+      if (linkDeg[id] < 2) linkInc[2 * id + linkDeg[id]] = static_cast<std::int32_t>(i / 2);
+      ++linkDeg[id];
+    }
+    bool loop = true;
+    for (size_t i = 0; i < link.size() && loop; ++i) loop = linkDeg[localId[link[i]]] == 2;
     size_t visited = 1;
     std::int32_t start = link[0], at = link[1];
-    size_t prevEdge = 0;
-    while (at != start && visited <= edges) {
-      size_t next = edges;
-      for (size_t e = 0; e < edges && next == edges; ++e)
-        if (e != prevEdge && (link[2 * e] == at || link[2 * e + 1] == at)) next = e;
-      if (next == edges) return false;
+    std::int32_t prevEdge = 0;
+    while (loop && at != start && visited <= edges) {
+      const std::int32_t id = localId[at];
+      const std::int32_t next = linkInc[2 * id] != prevEdge ? linkInc[2 * id] : linkInc[2 * id + 1];
       at = link[2 * next] == at ? link[2 * next + 1] : link[2 * next];
       prevEdge = next;
       ++visited;
     }
-    return at == start && visited == edges;
+    for (int w : nbrs) localId[w] = -1;
+    return loop && at == start && visited == edges;
   };
   std::vector<std::int32_t> around;
   std::vector<std::int32_t> lateSnapped;  // nodes snapNear moved onto the cut
@@ -534,6 +564,8 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       }
     }
   };
+  std::vector<std::int32_t> peelStamp, failedAt;
+  int peelCount = 0;
   auto peel = [&]() {
     if (!(options.peel_quality > 0)) return;
     std::vector<std::int32_t> candidates;
@@ -541,10 +573,28 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     candidates.erase(std::remove_if(candidates.begin(), candidates.end(),
                                     [&](int t) { return !(tetQ(t) < options.peel_quality); }),
                      candidates.end());
+    // A candidate's tests (a boundary face, the discs around its nodes) look only at the
+    // live tets around its nodes: one that failed them is not tested again until a tet with
+    // one of its nodes was peeled (peelStamp, per node: the count of peels when it last lost
+    // a tet; failedAt, per candidate: that count when it failed). The budget is asked anew.
+    if (peelStamp.empty()) peelStamp.assign(N, -1);
+    failedAt.assign(candidates.size(), -1);
     for (bool again = true; again;) {
       again = false;
-      for (int t : candidates) {
-        if ((*dead)[t] || boundaryFaceCount(t) == 0 || !budget.fits(-tetVolume(mesh, t))) continue;
+      for (size_t i = 0; i < candidates.size(); ++i) {
+        const int t = candidates[i];
+        if ((*dead)[t]) continue;
+        if (failedAt[i] >= 0) {
+          int last = -1;
+          for (int k = 0; k < 4; ++k) last = std::max(last, peelStamp[mesh.T(t, k)]);
+          if (last <= failedAt[i]) continue;
+          failedAt[i] = -1;
+        }
+        if (boundaryFaceCount(t) == 0) {
+          failedAt[i] = peelCount;
+          continue;
+        }
+        if (!budget.fits(-tetVolume(mesh, t))) continue;
         kill(t);
         bool ok = true;
         for (int k = 0; k < 4 && ok; ++k) {
@@ -553,8 +603,11 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
         }
         if (!ok) {
           (*dead)[t] = 0;
+          failedAt[i] = peelCount;
           continue;
         }
+        ++peelCount;
+        for (int k = 0; k < 4; ++k) peelStamp[mesh.T(t, k)] = peelCount;
         again = true;
         budget.spend(-tetVolume(mesh, t));
         if (counts) {
@@ -900,7 +953,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     // Does node n have a boundary face?
     auto onBoundary = [&](int n) {
       liveStar(n, vstar, nullptr);
-      discAround(n, vstar);
+      discAround(n, vstar, true);
       return !link.empty();
     };
     for (int batch = 0; batch < 3; ++batch) {
@@ -1159,6 +1212,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     std::sort(cands.begin(), cands.end());
     std::vector<std::int32_t> dying, changing, group, tets;
     std::vector<Vec3> targets, groupTo, groupFrom;
+    std::vector<std::uint32_t> groupVer;
     const double near = options.collapse_fraction * region.edge_length;
     auto inGroup = [&](int v) { return std::find(group.begin(), group.end(), v) != group.end(); };
     // Moves the group onto the cut and removes the tets that go flat, if that passes the
@@ -1213,9 +1267,11 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
         return false;
       }
       groupFrom.clear();
+      groupVer.clear();
       for (size_t g = 0; g < group.size(); ++g) {
         groupFrom.push_back(pos(group[g]));
-        mesh.X.row(group[g]) = groupTo[g].transpose();
+        groupVer.push_back(nodeVer[group[g]]);
+        setPos(group[g], groupTo[g]);
       }
       for (int t : dying) kill(t);
       bool ok = true;
@@ -1232,7 +1288,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
         }
       if (!ok) {
         for (int t : dying) (*dead)[t] = 0;
-        for (size_t g = 0; g < group.size(); ++g) mesh.X.row(group[g]) = groupFrom[g].transpose();
+        for (size_t g = 0; g < group.size(); ++g) restorePos(group[g], groupFrom[g], groupVer[g]);
         return false;
       }
       for (int g : group) {
@@ -1490,7 +1546,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       if (best > before) {
         moveBudget.spend(bestDv);
         largest = std::max(largest, (bestX - x).norm());
-        mesh.X.row(n) = bestX.transpose();
+        setPos(n, bestX);
         didMove[n] = 1;
         movedNow.push_back(n);
       }
