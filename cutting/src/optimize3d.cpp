@@ -31,6 +31,8 @@
 #include <array>
 #include <bit>
 #include <cmath>
+#include <cstdlib>
+#include <cstring>
 #include <limits>
 #include <vector>
 
@@ -162,12 +164,28 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   buildStars();
   // Peeling and collapses change the volume; together they may change it by at most
   // volume_budget of the mesh's volume.
+  // tetVolume's arithmetic in scalars (Eigen's cross is (y1 z2 - z1 y2, z1 x2 - x1 z2,
+  // x1 y2 - y1 x2), its 3-vector dot (a0 b0 + a1 b1) + a2 b2): the same value, without the
+  // out-of-line cross product per tet. X is column-major: three coordinate columns.
   double meshVolume = 0;
-  for (int t = 0; t < M; ++t) {
-    // tetVolume, inline.
-    const Vec3 x0 = mesh.X.row(mesh.T(t, 0)), x1 = mesh.X.row(mesh.T(t, 1)), x2 = mesh.X.row(mesh.T(t, 2)),
-               x3 = mesh.X.row(mesh.T(t, 3));
-    meshVolume += (x1 - x0).dot((x2 - x0).cross(x3 - x0)) / 6.0;
+  {
+    const double* cx = mesh.X.col(0).data();
+    const double* cy = mesh.X.col(1).data();
+    const double* cz = mesh.X.col(2).data();
+    for (int t = 0; t < M; ++t) {
+      const int i0 = mesh.T(t, 0), i1 = mesh.T(t, 1), i2 = mesh.T(t, 2), i3 = mesh.T(t, 3);
+      const double ax = cx[i1] - cx[i0], ay = cy[i1] - cy[i0], az = cz[i1] - cz[i0];
+      const double bx = cx[i2] - cx[i0], by = cy[i2] - cy[i0], bz = cz[i2] - cz[i0];
+      const double ex = cx[i3] - cx[i0], ey = cy[i3] - cy[i0], ez = cz[i3] - cz[i0];
+      const double nx = by * ez - bz * ey, ny = bz * ex - bx * ez, nz = bx * ey - by * ex;
+      const double v = (ax * nx + ay * ny) + az * nz;
+#ifdef HYSIM_CHECK_VOLUME
+      const Vec3 x0 = mesh.X.row(i0), x1 = mesh.X.row(i1), x2 = mesh.X.row(i2), x3 = mesh.X.row(i3);
+      const double ref = (x1 - x0).dot((x2 - x0).cross(x3 - x0));
+      if (std::memcmp(&ref, &v, sizeof v) != 0) std::abort();
+#endif
+      meshVolume += v / 6.0;
+    }
   }
   // Curved cuts: the budgets bound the net change of the mesh volume (collapses and moves
   // add and remove volume; what they move about cancels) and, at volume_churn_factor x
