@@ -179,7 +179,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       const double ex = cx[i3] - cx[i0], ey = cy[i3] - cy[i0], ez = cz[i3] - cz[i0];
       const double nx = by * ez - bz * ey, ny = bz * ex - bx * ez, nz = bx * ey - by * ex;
       const double v = (ax * nx + ay * ny) + az * nz;
-#ifdef HYSIM_CHECK_VOLUME
+#ifdef HYSIM_CHECK_EXACT
       const Vec3 x0 = mesh.X.row(i0), x1 = mesh.X.row(i1), x2 = mesh.X.row(i2), x3 = mesh.X.row(i3);
       const double ref = (x1 - x0).dot((x2 - x0).cross(x3 - x0));
       if (std::memcmp(&ref, &v, sizeof v) != 0) std::abort();
