@@ -63,6 +63,26 @@ inline double radiusRatioHere(const Vec3& a, const Vec3& b, const Vec3& c, const
   return std::isfinite(ratio) ? ratio : 0.0;
 }
 
+// tetVolume (mesh.cpp) inlined, in scalars over the coordinate columns: Eigen's cross
+// (y1 z2 - z1 y2, z1 x2 - x1 z2, x1 y2 - y1 x2) and 3-vector dot ((a0 b0 + a1 b1) + a2 b2),
+// the same expression and value as the mesh volume below (checked there bit for bit).
+inline double tetVolumeHere(const TetMesh& mesh, int t) {
+  const double* cx = mesh.X.col(0).data();
+  const double* cy = mesh.X.col(1).data();
+  const double* cz = mesh.X.col(2).data();
+  const int i0 = mesh.T(t, 0), i1 = mesh.T(t, 1), i2 = mesh.T(t, 2), i3 = mesh.T(t, 3);
+  const double ax = cx[i1] - cx[i0], ay = cy[i1] - cy[i0], az = cz[i1] - cz[i0];
+  const double bx = cx[i2] - cx[i0], by = cy[i2] - cy[i0], bz = cz[i2] - cz[i0];
+  const double ex = cx[i3] - cx[i0], ey = cy[i3] - cy[i0], ez = cz[i3] - cz[i0];
+  const double nx = by * ez - bz * ey, ny = bz * ex - bx * ez, nz = bx * ey - by * ex;
+  const double v = ((ax * nx + ay * ny) + az * nz) / 6.0;
+#ifdef HYSIM_CHECK_EXACT
+  const double ref = tetVolume(mesh, t);
+  if (std::memcmp(&ref, &v, sizeof v) != 0) std::abort();
+#endif
+  return v;
+}
+
 enum class Freedom { Free, Plane, Surface, Fan, Ridge, Fixed };
 
 // A volume budget: the net change stays within `limit`, the sum of the absolute changes
@@ -629,7 +649,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
           failedAt[i] = peelCount;
           continue;
         }
-        if (!budget.fits(-tetVolume(mesh, t))) continue;
+        if (!budget.fits(-tetVolumeHere(mesh, t))) continue;
         kill(t);
         bool ok = true;
         for (int k = 0; k < 4 && ok; ++k) {
@@ -644,10 +664,10 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
         ++peelCount;
         for (int k = 0; k < 4; ++k) peelStamp[mesh.T(t, k)] = peelCount;
         again = true;
-        budget.spend(-tetVolume(mesh, t));
+        budget.spend(-tetVolumeHere(mesh, t));
         if (counts) {
           ++counts->peeled;
-          counts->peeled_volume += tetVolume(mesh, t);
+          counts->peeled_volume += tetVolumeHere(mesh, t);
         }
       }
     }
@@ -1074,9 +1094,9 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
         if (!ok) continue;
         // Volume: the removed tets and the change of the others, against u's star.
         double before = 0, after = 0;
-        for (int t : dying) before += tetVolume(mesh, t);
+        for (int t : dying) before += tetVolumeHere(mesh, t);
         for (int t : changing) {
-          before += tetVolume(mesh, t);
+          before += tetVolumeHere(mesh, t);
           Vec3 p[4];
           for (int k = 0; k < 4; ++k) p[k] = mesh.T(t, k) == u ? pos(v) : pos(mesh.T(t, k));
           after += (p[1] - p[0]).dot((p[2] - p[0]).cross(p[3] - p[0])) / 6.0;
@@ -1275,7 +1295,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
             if (group[g] == v) p[k] = groupTo[g];
         }
         oldMin = std::min(oldMin, tetQ(t));
-        before += tetVolume(mesh, t);
+        before += tetVolumeHere(mesh, t);
         if (onAfter == 4) {
           dying.push_back(t);
           continue;
@@ -1560,7 +1580,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
           if (curved && (c.kind == Freedom::Surface || c.kind == Freedom::Fan || c.kind == Freedom::Ridge)) {
             if (starVolume.empty())  // the star's volumes where n is (the same for every candidate)
               for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s)
-                starVolume.push_back((*dead)[*s] ? 0.0 : tetVolume(mesh, *s));
+                starVolume.push_back((*dead)[*s] ? 0.0 : tetVolumeHere(mesh, *s));
             const double* oldVolume = starVolume.data();
             for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s, ++oldVolume) {
               if ((*dead)[*s]) continue;
