@@ -31,6 +31,8 @@
 #include <array>
 #include <bit>
 #include <cmath>
+#include <cstdlib>
+#include <cstring>
 #include <limits>
 #include <vector>
 
@@ -44,6 +46,42 @@ namespace {
 
 using Vec3 = Eigen::Vector3d;
 constexpr int kFace[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
+
+// radiusRatio (mesh_stats.cpp) with the same expressions in the same order, here where the
+// compiler can inline it (the optimiser's hot loops evaluate it millions of times).
+inline double radiusRatioHere(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
+  const double volume = std::abs((b - a).dot((c - a).cross(d - a))) / 6.0;
+  const double p = (b - a).norm() * (d - c).norm();
+  const double q = (c - a).norm() * (d - b).norm();
+  const double r = (d - a).norm() * (c - b).norm();
+  const double product = std::max(0.0, (p + q + r) * (p + q - r) * (p - q + r) * (-p + q + r));
+  const double faceArea = 0.5 * ((b - a).cross(c - a).norm() + (b - a).cross(d - a).norm() +
+                                 (c - a).cross(d - a).norm() + (c - b).cross(d - b).norm());
+  const double denominator = faceArea * std::sqrt(product);
+  if (!(denominator > 0) || !std::isfinite(denominator)) return 0.0;
+  const double ratio = 72.0 * volume * volume / denominator;
+  return std::isfinite(ratio) ? ratio : 0.0;
+}
+
+// tetVolume (mesh.cpp) inlined, in scalars over the coordinate columns: Eigen's cross
+// (y1 z2 - z1 y2, z1 x2 - x1 z2, x1 y2 - y1 x2) and 3-vector dot ((a0 b0 + a1 b1) + a2 b2),
+// the same expression and value as the mesh volume below (checked there bit for bit).
+inline double tetVolumeHere(const TetMesh& mesh, int t) {
+  const double* cx = mesh.X.col(0).data();
+  const double* cy = mesh.X.col(1).data();
+  const double* cz = mesh.X.col(2).data();
+  const int i0 = mesh.T(t, 0), i1 = mesh.T(t, 1), i2 = mesh.T(t, 2), i3 = mesh.T(t, 3);
+  const double ax = cx[i1] - cx[i0], ay = cy[i1] - cy[i0], az = cz[i1] - cz[i0];
+  const double bx = cx[i2] - cx[i0], by = cy[i2] - cy[i0], bz = cz[i2] - cz[i0];
+  const double ex = cx[i3] - cx[i0], ey = cy[i3] - cy[i0], ez = cz[i3] - cz[i0];
+  const double nx = by * ez - bz * ey, ny = bz * ex - bx * ez, nz = bx * ey - by * ex;
+  const double v = ((ax * nx + ay * ny) + az * nz) / 6.0;
+#ifdef HYSIM_CHECK_EXACT
+  const double ref = tetVolume(mesh, t);
+  if (std::memcmp(&ref, &v, sizeof v) != 0) std::abort();
+#endif
+  return v;
+}
 
 enum class Freedom { Free, Plane, Surface, Fan, Ridge, Fixed };
 
@@ -146,12 +184,28 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   buildStars();
   // Peeling and collapses change the volume; together they may change it by at most
   // volume_budget of the mesh's volume.
+  // tetVolume's arithmetic in scalars (Eigen's cross is (y1 z2 - z1 y2, z1 x2 - x1 z2,
+  // x1 y2 - y1 x2), its 3-vector dot (a0 b0 + a1 b1) + a2 b2): the same value, without the
+  // out-of-line cross product per tet. X is column-major: three coordinate columns.
   double meshVolume = 0;
-  for (int t = 0; t < M; ++t) {
-    // tetVolume, inline.
-    const Vec3 x0 = mesh.X.row(mesh.T(t, 0)), x1 = mesh.X.row(mesh.T(t, 1)), x2 = mesh.X.row(mesh.T(t, 2)),
-               x3 = mesh.X.row(mesh.T(t, 3));
-    meshVolume += (x1 - x0).dot((x2 - x0).cross(x3 - x0)) / 6.0;
+  {
+    const double* cx = mesh.X.col(0).data();
+    const double* cy = mesh.X.col(1).data();
+    const double* cz = mesh.X.col(2).data();
+    for (int t = 0; t < M; ++t) {
+      const int i0 = mesh.T(t, 0), i1 = mesh.T(t, 1), i2 = mesh.T(t, 2), i3 = mesh.T(t, 3);
+      const double ax = cx[i1] - cx[i0], ay = cy[i1] - cy[i0], az = cz[i1] - cz[i0];
+      const double bx = cx[i2] - cx[i0], by = cy[i2] - cy[i0], bz = cz[i2] - cz[i0];
+      const double ex = cx[i3] - cx[i0], ey = cy[i3] - cy[i0], ez = cz[i3] - cz[i0];
+      const double nx = by * ez - bz * ey, ny = bz * ex - bx * ez, nz = bx * ey - by * ex;
+      const double v = (ax * nx + ay * ny) + az * nz;
+#ifdef HYSIM_CHECK_EXACT
+      const Vec3 x0 = mesh.X.row(i0), x1 = mesh.X.row(i1), x2 = mesh.X.row(i2), x3 = mesh.X.row(i3);
+      const double ref = (x1 - x0).dot((x2 - x0).cross(x3 - x0));
+      if (std::memcmp(&ref, &v, sizeof v) != 0) std::abort();
+#endif
+      meshVolume += v / 6.0;
+    }
   }
   // Curved cuts: the budgets bound the net change of the mesh volume (collapses and moves
   // add and remove volume; what they move about cancels) and, at volume_churn_factor x
@@ -167,11 +221,23 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   VolumeBudget moveBudget{meshVolume * options.move_volume_budget, churnFactor};
   const double refVolume = curved && options.collapse_volume_fraction_of_edge_tet ? edgeTet : 0.0;
   auto pos = [&](int i) -> Vec3 { return mesh.X.row(i).transpose(); };
-  // q* of tet t, cached per tet with the node indices and positions it was computed from
-  // (a hit needs all of them unchanged, so the value is exactly what radiusRatio returns).
+  // q* of tet t, cached per tet with the node indices and the nodes' versions it was computed
+  // from (nodeVer[n] counts the writes of n's position here; a hit needs the same nodes, none
+  // moved since, so the value is exactly what radiusRatio returns).
+  // (Each write takes a new number; restorePos puts back a position and the number it had.)
+  std::vector<std::uint32_t> nodeVer(N, 0);
+  std::uint32_t verClock = 0;
+  auto setPos = [&](int n, const Vec3& x) {
+    mesh.X.row(n) = x.transpose();
+    nodeVer[n] = ++verClock;
+  };
+  auto restorePos = [&](int n, const Vec3& x, std::uint32_t ver) {
+    mesh.X.row(n) = x.transpose();
+    nodeVer[n] = ver;
+  };
   struct QEntry {
     std::int32_t v[4];
-    double x[12];
+    std::uint32_t ver[4];
     double q;
   };
   std::vector<std::int32_t> qSlot(M, -1);
@@ -180,17 +246,17 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     QEntry cur;
     for (int k = 0; k < 4; ++k) {
       cur.v[k] = mesh.T(t, k);
-      for (int a = 0; a < 3; ++a) cur.x[3 * k + a] = mesh.X(cur.v[k], a);
+      cur.ver[k] = nodeVer[cur.v[k]];
     }
     std::int32_t& slot = qSlot[t];
     if (slot >= 0) {
       const QEntry& e = qPool[slot];
-      if (std::equal(cur.v, cur.v + 4, e.v) && std::equal(cur.x, cur.x + 12, e.x)) return e.q;
+      if (std::equal(cur.v, cur.v + 4, e.v) && std::equal(cur.ver, cur.ver + 4, e.ver)) return e.q;
     } else {
       slot = static_cast<std::int32_t>(qPool.size());
       qPool.emplace_back();
     }
-    cur.q = radiusRatio(pos(cur.v[0]), pos(cur.v[1]), pos(cur.v[2]), pos(cur.v[3]));
+    cur.q = radiusRatioHere(pos(cur.v[0]), pos(cur.v[1]), pos(cur.v[2]), pos(cur.v[3]));
     qPool[slot] = cur;
     return cur.q;
   };
@@ -199,7 +265,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     Vec3 p[4];
     for (int k = 0; k < 4; ++k) p[k] = mesh.T(t, k) == n ? y : pos(mesh.T(t, k));
     if (!((p[1] - p[0]).dot((p[2] - p[0]).cross(p[3] - p[0])) > 0)) return -1.0;
-    return radiusRatio(p[0], p[1], p[2], p[3]);
+    return radiusRatioHere(p[0], p[1], p[2], p[3]);
   };
   // Worst q* around n where it is (tetQAt at its own position, through the cache).
   auto starWorst = [&](int n, int* worstTet) {
@@ -220,8 +286,9 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   // Is the worst q* around n with n at y above `floor`? Tet `first` (the likely worst) is
   // tried first and the scan stops at the first tet at or below the floor; when it passes,
   // *q receives the worst q* (as starWorst).
-  auto starAbove = [&](int n, const Vec3& y, int first, double floor, double* q) {
-    double worst = tetQAt(first, n, y);
+  // (firstQ: tetQAt(first, n, y), which the caller has already computed.)
+  auto starAbove = [&](int n, const Vec3& y, int first, double firstQ, double floor, double* q) {
+    double worst = firstQ;
     if (!(worst > floor)) return false;
     for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s) {
       if ((*s) == first || (*dead)[(*s)]) continue;
@@ -405,74 +472,92 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   // Is the neighbourhood of v (tets `around`) manifold: every face used by at most two tets,
   // and the boundary faces around v one closed loop (or none: interior)? No tets: the node
   // goes away (compacted), which is fine.
-  auto discAround = [&](int v, const std::vector<std::int32_t>& around) {
+  // linkOnly: only fill `link` (the boundary edges around v, up to the first face used by
+  // more than two tets) and return whether the faces are; the loop check is skipped.
+  std::vector<std::int32_t> linkDeg, linkInc, tetLocal;
+  std::vector<std::uint16_t> faceUses;
+  auto discAround = [&](int v, const std::vector<std::int32_t>& around, bool linkOnly = false) {
     link.clear();
     if (around.empty()) return true;
     // Every tet of `around` has v; a face (v, a, b) is used by the tets with both a and b:
     // count the pairs of each tet's other three nodes in a table over v's neighbours.
+    // Each tet's nodes as local numbers (-1: v), read from the mesh once.
     nbrs.clear();
-    for (int t : around)
+    tetLocal.resize(4 * around.size());
+    for (size_t i = 0; i < around.size(); ++i)
       for (int k = 0; k < 4; ++k) {
-        const int w = mesh.T(t, k);
-        if (w != v && localId[w] < 0) {
+        const int w = mesh.T(around[i], k);
+        if (w == v) {
+          tetLocal[4 * i + k] = -1;
+          continue;
+        }
+        if (localId[w] < 0) {
           localId[w] = static_cast<std::int32_t>(nbrs.size());
           nbrs.push_back(w);
         }
+        tetLocal[4 * i + k] = localId[w];
       }
     const size_t L = nbrs.size();
-    pairCount.assign(L * L, 0);
-    for (int t : around) {
+    faceUses.assign(L * L, 0);
+    for (size_t i = 0; i < around.size(); ++i) {
       std::int32_t o[3], m = 0;
       for (int k = 0; k < 4; ++k)
-        if (mesh.T(t, k) != v && m < 3) o[m++] = localId[mesh.T(t, k)];
-      for (int i = 0; i < m; ++i)
-        for (int j = i + 1; j < m; ++j) ++pairCount[std::min(o[i], o[j]) * L + std::max(o[i], o[j])];
+        if (tetLocal[4 * i + k] >= 0 && m < 3) o[m++] = tetLocal[4 * i + k];
+      for (int a = 0; a < m; ++a)
+        for (int b = a + 1; b < m; ++b) ++faceUses[std::min(o[a], o[b]) * L + std::max(o[a], o[b])];
     }
     bool manifold = true;
     for (size_t i = 0; i < around.size() && manifold; ++i) {
-      const int t = around[i];
+      const std::int32_t* tl = &tetLocal[4 * i];
       int lv = 0;
-      while (mesh.T(t, lv) != v) ++lv;
+      while (tl[lv] >= 0) ++lv;
+      // The faces f != lv in order; face f at v: the two nodes other than f and lv.
       for (int f = 0; f < 4; ++f) {
         if (f == lv) continue;
         std::int32_t o[2], m = 0;
-        for (int k = 0; k < 3; ++k)
-          if (mesh.T(t, kFace[f][k]) != v) o[m++] = mesh.T(t, kFace[f][k]);
-        const std::int32_t a = localId[o[0]], b = localId[o[1]];
-        const int uses = pairCount[std::min(a, b) * L + std::max(a, b)];
+        for (int k = 0; k < 4; ++k)
+          if (k != f && k != lv) o[m++] = tl[k];
+        const std::uint16_t uses = faceUses[std::min(o[0], o[1]) * L + std::max(o[0], o[1])];
         if (uses > 2) {
           manifold = false;
           break;
         }
         if (uses == 1) {
-          link.push_back(o[0]);
-          link.push_back(o[1]);
+          link.push_back(nbrs[o[0]]);
+          link.push_back(nbrs[o[1]]);
         }
       }
     }
-    for (int w : nbrs) localId[w] = -1;
-    if (!manifold) return false;
-    if (link.empty()) return true;  // interior node
-    // One closed loop: every link vertex has degree 2, and walking from one edge visits all.
-    const size_t edges = link.size() / 2;
-    for (size_t i = 0; i < link.size(); ++i) {
-      int degree = 0;
-      for (size_t j = 0; j < link.size(); ++j) degree += link[j] == link[i];
-      if (degree != 2) return false;
+    if (!manifold || link.empty() || linkOnly) {
+      for (int w : nbrs) localId[w] = -1;
+      return manifold;  // (link.empty(): an interior node)
     }
+    // One closed loop: every link vertex has degree 2, and walking from one edge visits all.
+    // Each link vertex's (first two) edges in a table over v's neighbours: with all degrees 2
+    // the walk from edge 0 leaves each vertex by its other edge, and it visits all edges iff
+    // they form one loop.
+    const size_t edges = link.size() / 2;
+    linkDeg.assign(L, 0);
+    linkInc.resize(2 * L);
+    for (size_t i = 0; i < link.size(); ++i) {
+      const std::int32_t id = localId[link[i]];
+      if (linkDeg[id] < 2) linkInc[2 * id + linkDeg[id]] = static_cast<std::int32_t>(i / 2);
+      ++linkDeg[id];
+    }
+    bool loop = true;
+    for (size_t i = 0; i < link.size() && loop; ++i) loop = linkDeg[localId[link[i]]] == 2;
     size_t visited = 1;
     std::int32_t start = link[0], at = link[1];
-    size_t prevEdge = 0;
-    while (at != start && visited <= edges) {
-      size_t next = edges;
-      for (size_t e = 0; e < edges && next == edges; ++e)
-        if (e != prevEdge && (link[2 * e] == at || link[2 * e + 1] == at)) next = e;
-      if (next == edges) return false;
+    std::int32_t prevEdge = 0;
+    while (loop && at != start && visited <= edges) {
+      const std::int32_t id = localId[at];
+      const std::int32_t next = linkInc[2 * id] != prevEdge ? linkInc[2 * id] : linkInc[2 * id + 1];
       at = link[2 * next] == at ? link[2 * next + 1] : link[2 * next];
       prevEdge = next;
       ++visited;
     }
-    return at == start && visited == edges;
+    for (int w : nbrs) localId[w] = -1;
+    return loop && at == start && visited == edges;
   };
   std::vector<std::int32_t> around;
   std::vector<std::int32_t> lateSnapped;  // nodes snapNear moved onto the cut
@@ -534,6 +619,8 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       }
     }
   };
+  std::vector<std::int32_t> peelStamp, failedAt;
+  int peelCount = 0;
   auto peel = [&]() {
     if (!(options.peel_quality > 0)) return;
     std::vector<std::int32_t> candidates;
@@ -541,10 +628,28 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     candidates.erase(std::remove_if(candidates.begin(), candidates.end(),
                                     [&](int t) { return !(tetQ(t) < options.peel_quality); }),
                      candidates.end());
+    // A candidate's tests (a boundary face, the discs around its nodes) look only at the
+    // live tets around its nodes: one that failed them is not tested again until a tet with
+    // one of its nodes was peeled (peelStamp, per node: the count of peels when it last lost
+    // a tet; failedAt, per candidate: that count when it failed). The budget is asked anew.
+    if (peelStamp.empty()) peelStamp.assign(N, -1);
+    failedAt.assign(candidates.size(), -1);
     for (bool again = true; again;) {
       again = false;
-      for (int t : candidates) {
-        if ((*dead)[t] || boundaryFaceCount(t) == 0 || !budget.fits(-tetVolume(mesh, t))) continue;
+      for (size_t i = 0; i < candidates.size(); ++i) {
+        const int t = candidates[i];
+        if ((*dead)[t]) continue;
+        if (failedAt[i] >= 0) {
+          int last = -1;
+          for (int k = 0; k < 4; ++k) last = std::max(last, peelStamp[mesh.T(t, k)]);
+          if (last <= failedAt[i]) continue;
+          failedAt[i] = -1;
+        }
+        if (boundaryFaceCount(t) == 0) {
+          failedAt[i] = peelCount;
+          continue;
+        }
+        if (!budget.fits(-tetVolumeHere(mesh, t))) continue;
         kill(t);
         bool ok = true;
         for (int k = 0; k < 4 && ok; ++k) {
@@ -553,13 +658,16 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
         }
         if (!ok) {
           (*dead)[t] = 0;
+          failedAt[i] = peelCount;
           continue;
         }
+        ++peelCount;
+        for (int k = 0; k < 4; ++k) peelStamp[mesh.T(t, k)] = peelCount;
         again = true;
-        budget.spend(-tetVolume(mesh, t));
+        budget.spend(-tetVolumeHere(mesh, t));
         if (counts) {
           ++counts->peeled;
-          counts->peeled_volume += tetVolume(mesh, t);
+          counts->peeled_volume += tetVolumeHere(mesh, t);
         }
       }
     }
@@ -585,7 +693,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       return (pos(b) - p0).dot((pos(c) - p0).cross(pos(d) - p0));
     };
     auto q4 = [&](int a, int b, int c, int d) {
-      return vol6(a, b, c, d) > 0 ? radiusRatio(pos(a), pos(b), pos(c), pos(d)) : -1.0;
+      return vol6(a, b, c, d) > 0 ? radiusRatioHere(pos(a), pos(b), pos(c), pos(d)) : -1.0;
     };
     auto setTet = [&](int t, int a, int b, int c, int d) {
       const int v[4] = {a, b, c, d};
@@ -900,7 +1008,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     // Does node n have a boundary face?
     auto onBoundary = [&](int n) {
       liveStar(n, vstar, nullptr);
-      discAround(n, vstar);
+      discAround(n, vstar, true);
       return !link.empty();
     };
     for (int batch = 0; batch < 3; ++batch) {
@@ -986,9 +1094,9 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
         if (!ok) continue;
         // Volume: the removed tets and the change of the others, against u's star.
         double before = 0, after = 0;
-        for (int t : dying) before += tetVolume(mesh, t);
+        for (int t : dying) before += tetVolumeHere(mesh, t);
         for (int t : changing) {
-          before += tetVolume(mesh, t);
+          before += tetVolumeHere(mesh, t);
           Vec3 p[4];
           for (int k = 0; k < 4; ++k) p[k] = mesh.T(t, k) == u ? pos(v) : pos(mesh.T(t, k));
           after += (p[1] - p[0]).dot((p[2] - p[0]).cross(p[3] - p[0])) / 6.0;
@@ -1159,6 +1267,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     std::sort(cands.begin(), cands.end());
     std::vector<std::int32_t> dying, changing, group, tets;
     std::vector<Vec3> targets, groupTo, groupFrom;
+    std::vector<std::uint32_t> groupVer;
     const double near = options.collapse_fraction * region.edge_length;
     auto inGroup = [&](int v) { return std::find(group.begin(), group.end(), v) != group.end(); };
     // Moves the group onto the cut and removes the tets that go flat, if that passes the
@@ -1186,14 +1295,14 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
             if (group[g] == v) p[k] = groupTo[g];
         }
         oldMin = std::min(oldMin, tetQ(t));
-        before += tetVolume(mesh, t);
+        before += tetVolumeHere(mesh, t);
         if (onAfter == 4) {
           dying.push_back(t);
           continue;
         }
         changing.push_back(t);
         const double vol = (p[1] - p[0]).dot((p[2] - p[0]).cross(p[3] - p[0])) / 6.0;
-        const double q = vol > 0 ? radiusRatio(p[0], p[1], p[2], p[3]) : -1.0;
+        const double q = vol > 0 ? radiusRatioHere(p[0], p[1], p[2], p[3]) : -1.0;
         if (q < newMin) {
           newMin = q;
           worstTet = t;
@@ -1213,9 +1322,11 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
         return false;
       }
       groupFrom.clear();
+      groupVer.clear();
       for (size_t g = 0; g < group.size(); ++g) {
         groupFrom.push_back(pos(group[g]));
-        mesh.X.row(group[g]) = groupTo[g].transpose();
+        groupVer.push_back(nodeVer[group[g]]);
+        setPos(group[g], groupTo[g]);
       }
       for (int t : dying) kill(t);
       bool ok = true;
@@ -1232,7 +1343,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
         }
       if (!ok) {
         for (int t : dying) (*dead)[t] = 0;
-        for (size_t g = 0; g < group.size(); ++g) mesh.X.row(group[g]) = groupFrom[g].transpose();
+        for (size_t g = 0; g < group.size(); ++g) restorePos(group[g], groupFrom[g], groupVer[g]);
         return false;
       }
       for (int g : group) {
@@ -1461,14 +1572,15 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
           }
           // The checks below must all pass and have no side effects: the cheapest first (the
           // worst tet, which starAbove tries first anyway), the surface queries after it.
-          if (!(tetQAt(wt, n, y) > best)) continue;
+          const double qFirst = tetQAt(wt, n, y);
+          if (!(qFirst > best)) continue;
           if (!sideOk(y)) continue;
           // Moves on a curved surface change the volume a little (the faces are chords): within the budget.
           double dv = 0;
           if (curved && (c.kind == Freedom::Surface || c.kind == Freedom::Fan || c.kind == Freedom::Ridge)) {
             if (starVolume.empty())  // the star's volumes where n is (the same for every candidate)
               for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s)
-                starVolume.push_back((*dead)[*s] ? 0.0 : tetVolume(mesh, *s));
+                starVolume.push_back((*dead)[*s] ? 0.0 : tetVolumeHere(mesh, *s));
             const double* oldVolume = starVolume.data();
             for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s, ++oldVolume) {
               if ((*dead)[*s]) continue;
@@ -1479,7 +1591,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
             if (!moveBudget.fits(dv) || std::abs(dv) > options.move_volume_fraction * edgeTet) continue;
           }
           double q = 0;
-          if (starAbove(n, y, wt, best, &q)) {
+          if (starAbove(n, y, wt, qFirst, best, &q)) {
             best = q;
             bestX = y;
             bestDv = dv;
@@ -1490,7 +1602,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       if (best > before) {
         moveBudget.spend(bestDv);
         largest = std::max(largest, (bestX - x).norm());
-        mesh.X.row(n) = bestX.transpose();
+        setPos(n, bestX);
         didMove[n] = 1;
         movedNow.push_back(n);
       }
