@@ -223,6 +223,7 @@ Status Simulation::rebuildGeometry(PassRecord* timing, const std::vector<std::ui
   if (Status st = buildGeometry(mesh_, state_.x, timing, boundary); !st.ok()) return st;
   PassTimer timer;
   locator_.build(mesh_, state_.x);
+  buildNearest(mesh_, state_.x);
   timer.lap(timing ? &timing->locator_ms : nullptr);
   finishGeometry(timing);
   return Status::Ok();
@@ -283,6 +284,72 @@ void Simulation::waitLocator() const {
 
 Simulation::~Simulation() { waitLocator(); }
 
+void Simulation::buildNearest(const cutting::TetMesh& mesh, const sim::NodeVectors& x) {
+  nearest_x_ = x;
+  nearest_surface_.build(nearest_x_, surface_nodes_);
+  node_tet_.assign(static_cast<size_t>(mesh.numNodes()), -1);
+  for (int t = 0; t < mesh.numTets(); ++t)
+    for (int k = 0; k < 4; ++k) node_tet_[mesh.T(t, k)] = t;
+}
+
+bool Simulation::mapToRest(const Eigen::Vector3d& p, double displacement, Eigen::Vector3d& rest) const {
+  int t = locator_.locate(mesh_, state_.x, p, displacement);
+  if (t < 0) {
+    const int nearest = nearest_surface_.nearest(p);
+    if (nearest < 0) return false;
+    t = node_tet_[nearest];
+    if (t < 0) return false;
+  }
+  // Barycentric coordinates of p in tet t at positions state_.x (may lie outside [0, 1]).
+  const Eigen::Vector3d a = state_.x.row(mesh_.T(t, 0)).transpose();
+  Eigen::Matrix3d m;
+  for (int k = 0; k < 3; ++k) m.col(k) = state_.x.row(mesh_.T(t, k + 1)).transpose() - a;
+  const Eigen::Vector3d w = m.inverse() * (p - a);
+  rest = (1.0 - w.sum()) * mesh_.X.row(mesh_.T(t, 0)).transpose();
+  for (int k = 0; k < 3; ++k) rest += w[k] * mesh_.X.row(mesh_.T(t, k + 1)).transpose();
+  return true;
+}
+
+bool Simulation::mapRow(int row, const Eigen::Vector3d& shift) {
+  // A query looks at the cells within the nodes' largest displacement since the locator's
+  // build: past a millimetre, a fresh build (~0.6 ms) costs less than the row's queries
+  // over the rest of the pass.
+  double displacement = locator_.maxDisplacement(state_.x);
+  if (displacement > 1.0) {
+    locator_.build(mesh_, state_.x);
+    displacement = 0.0;
+  }
+  for (int i = 0; i < sweep_.rowSize(); ++i) {
+    Eigen::Vector3d rest;
+    if (!mapToRest(sweep_.point(row, i) + shift, displacement, rest)) return false;
+    rest_rows_.push_back(rest);
+  }
+  return true;
+}
+
+void Simulation::mapSweepRows() {
+  const int rows = sweep_.numRows(), n = sweep_.rowSize();
+  if (rows < 2 || map_failed_) return;
+  waitLocator();  // the last pass's locator and nearest-node lookups (long done, in practice)
+  if (rest_rows_.empty()) {  // the row before the start
+    const Eigen::Vector3d shift = -1.5 * sweep_.motion(0, 1);
+    if (!mapRow(0, shift)) {
+      map_failed_ = true;
+      return;
+    }
+    kept_middle_ = sweep_.point(0, n / 2) + shift;
+  }
+  for (; swept_rows_mapped_ < rows; ++swept_rows_mapped_) {
+    const Eigen::Vector3d middle = sweep_.point(swept_rows_mapped_, n / 2);
+    if ((middle - kept_middle_).norm() < 0.3) continue;
+    if (!mapRow(swept_rows_mapped_, Eigen::Vector3d::Zero())) {
+      map_failed_ = true;
+      return;
+    }
+    kept_middle_ = middle;
+  }
+}
+
 void Simulation::finishGeometry(PassRecord* timing) {
   PassTimer timer;
   if (on_cut_.size() != static_cast<size_t>(mesh_.numNodes())) on_cut_.assign(mesh_.numNodes(), 0);
@@ -318,6 +385,7 @@ Result<std::unique_ptr<Simulation>> Simulation::create(const Scene& scene) {
   s->previous_wire_ = s->wire_;
   s->swept_wire_.reset(static_cast<int>(s->wire_.rows()));
   s->sweep_.reserve(10000, static_cast<int>(s->wire_.rows()));  // a 10 s pass without allocating
+  s->rest_rows_.reserve(2000 * static_cast<size_t>(s->wire_.rows()));  // its kept rows, 0.3 mm apart
   if (scene.chips.mode == ChipSettings::Mode::Simulate) {
     ChipToolGeometry tool;
     tool.shaft_radius_mm = scene.contact.shaft_radius_mm;
@@ -473,10 +541,15 @@ void Simulation::step() {
   if (loop_in_tissue_ && !cutting_) {
     cutting_ = true;
     sweep_.clear();
+    rest_rows_.clear();
+    swept_rows_mapped_ = 0;
+    map_failed_ = false;
     if (previous_wire_.rows() == wire_.rows()) sweep_.advance(previous_wire_);
     sweep_.advance(wire_);
+    mapSweepRows();
   } else if (loop_in_tissue_) {
     sweep_.advance(wire_);
+    mapSweepRows();
   } else if (cutting_) {
     sweep_.advance(wire_);
     finishPass();
@@ -518,10 +591,6 @@ void Simulation::finishPass() {
   cutting_ = false;
   PassRecord rec;
   rec.time_s = state_.time;
-  Eigen::Matrix<double, Eigen::Dynamic, 3> sv;
-  Eigen::Matrix<int, Eigen::Dynamic, 3> sf;
-  sweep_.extendedSurface(1.5, sv, sf);
-  sweep_.clear();
   auto fail = [&](const std::string& why) {
     rec.cut_failed = true;
     rec.message = why;
@@ -529,68 +598,24 @@ void Simulation::finishPass() {
     rec.nodes = mesh_.numNodes();
     passes_.push_back(rec);
   };
-  if (sf.rows() == 0) return fail("sweep too short");
-  for (int t = 0; t < sf.rows(); ++t) {
-    rec.sweep_area_mm2 +=
-        0.5 * (sv.row(sf(t, 1)) - sv.row(sf(t, 0))).cross(sv.row(sf(t, 2)) - sv.row(sf(t, 0))).norm();
+  const int rows = sweep_.numRows(), row_size = sweep_.rowSize();
+  if (rows < 2 || row_size < 2) {
+    sweep_.clear();
+    return fail("sweep too short");
   }
+  rec.sweep_area_mm2 = sweep_.extendedArea(1.5);
   // The cut happens in the rest configuration, so that the mesh the model is built from (and
   // the cut's quality guarantees) are the cut's own, not a deformed copy mapped back. The
-  // sweep is first thinned to rows ~0.3 mm apart (it holds a row every step, a few um apart),
-  // then each of its points is carried from the deformed tissue to the rest shape through the
-  // tet that contains it (outside the tissue: the affine map of a tet at the nearest surface
-  // node, which continues the deformation smoothly).
-  const int row_size = static_cast<int>(wire_.rows());
-  const int rows = static_cast<int>(sv.rows()) / row_size;
-  std::vector<int> kept_rows{0};
-  for (int r = 1; r < rows; ++r) {
-    const int last = kept_rows.back();
-    const double moved = (sv.row(r * row_size + row_size / 2) - sv.row(last * row_size + row_size / 2)).norm();
-    if (moved >= 0.3 || r == rows - 1) kept_rows.push_back(r);
-  }
-  // A query looks at the cells within the nodes' largest displacement since the build: past
-  // half a millimetre, a fresh build (~0.6 ms) costs less than the sweep's ~1000 queries
-  // (bench_pass_geometry on the 52 dumped passes: all queries ~0.4 ms + 1.2 ms per mm of
-  // displacement). The answers are the same either way.
-  double displacement = locator_.maxDisplacement(state_.x);  // since the locator's build
-  if (displacement > 0.5) {
-    locator_.build(mesh_, state_.x);
-    displacement = 0.0;
-  }
-  // Barycentric coordinates of p in tet t at positions x (may lie outside [0, 1]).
-  auto barycentric = [&](int t, const Eigen::Vector3d& p) {
-    const Eigen::Vector3d a = state_.x.row(mesh_.T(t, 0)).transpose();
-    Eigen::Matrix3d m;
-    for (int k = 0; k < 3; ++k) m.col(k) = state_.x.row(mesh_.T(t, k + 1)).transpose() - a;
-    const Eigen::Vector3d w = m.inverse() * (p - a);
-    return Eigen::Vector4d(1.0 - w.sum(), w[0], w[1], w[2]);
-  };
-  std::vector<int> node_tet;  // a tet around each node (the last that has it), at the first point outside
-  const int kept = static_cast<int>(kept_rows.size());
-  NearestPoint nearest_surface;  // built at the first point outside the tissue
-  bool nearest_built = false;
+  // sweep's rows up to this step were carried to the rest shape as they came (mapSweepRows:
+  // a row every ~0.3 mm, through the tissue as it was then); the row 1.5 mm past the end
+  // follows now.
+  mapSweepRows();
+  if (!map_failed_ && !mapRow(rows - 1, 1.5 * sweep_.motion(rows - 2, rows - 1))) map_failed_ = true;
+  sweep_.clear();
+  if (map_failed_) return fail("no tissue to map the sweep to");
+  const int kept = static_cast<int>(rest_rows_.size()) / row_size;
   cutting::Positions rv(static_cast<Eigen::Index>(kept) * row_size, 3);
-  for (int r = 0; r < kept; ++r)
-    for (int i = 0; i < row_size; ++i) {
-      const Eigen::Vector3d p = sv.row(kept_rows[r] * row_size + i).transpose();
-      int t = locator_.locate(mesh_, state_.x, p, displacement);
-      if (t < 0) {
-        if (!nearest_built) {
-          nearest_surface.build(state_.x, surface_nodes_);
-          node_tet.assign(static_cast<size_t>(mesh_.numNodes()), -1);
-          for (int u = 0; u < mesh_.numTets(); ++u)
-            for (int k = 0; k < 4; ++k) node_tet[mesh_.T(u, k)] = u;
-          nearest_built = true;
-        }
-        const int nearest = nearest_surface.nearest(p);
-        if (nearest < 0) return fail("no tissue to map the sweep to");
-        t = node_tet[nearest];
-      }
-      const Eigen::Vector4d w = barycentric(t, p);
-      Eigen::RowVector3d q = Eigen::RowVector3d::Zero();
-      for (int k = 0; k < 4; ++k) q += w[k] * mesh_.X.row(mesh_.T(t, k));
-      rv.row(static_cast<Eigen::Index>(r) * row_size + i) = q;
-    }
+  for (Eigen::Index i = 0; i < rv.rows(); ++i) rv.row(i) = rest_rows_[static_cast<size_t>(i)].transpose();
   cutting::Tris rf(static_cast<Eigen::Index>(2 * (kept - 1) * (row_size - 1)), 3);
   for (int r = 0, f = 0; r + 1 < kept; ++r)
     for (int i = 0; i + 1 < row_size; ++i) {
@@ -849,6 +874,7 @@ void Simulation::finishPass() {
   locator_thread_ = std::thread([this, x = std::move(x_kept), locator_ms] {
     PassTimer build_timer;
     locator_.build(mesh_, x);
+    buildNearest(mesh_, x);
     build_timer.lap(locator_ms);
   });
 }

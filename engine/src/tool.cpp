@@ -31,6 +31,25 @@ void Sweep::clear() {
   num_rows_ = 0;
   num_quads_ = 0;
   path_length_ = 0.0;
+  strip_area_ = 0.0;
+}
+
+// Area of the quad strip between rows a and b (#n points each), as triangles (a_i, a_i+1,
+// b_i+1) and (a_i, b_i+1, b_i), the order triangles() gives.
+template <class RowA, class RowB>
+static double quadStripArea(int n, const RowA& a, const RowB& b) {
+  double total = 0.0;
+  for (int i = 0; i + 1 < n; ++i) {
+    const Eigen::Vector3d p = a(i), q = a(i + 1), r = b(i + 1), s = b(i);
+    total += 0.5 * (q - p).cross(r - p).norm() + 0.5 * (r - p).cross(s - p).norm();
+  }
+  return total;
+}
+
+Eigen::Vector3d Sweep::motion(int from, int to) const {
+  Eigen::Vector3d d = Eigen::Vector3d::Zero();
+  for (int i = 0; i < row_size_; ++i) d += point(to, i) - point(from, i);
+  return d.norm() > 0.0 ? Eigen::Vector3d(d.normalized()) : d;
 }
 
 void Sweep::advance(const Eigen::Matrix<double, Eigen::Dynamic, 3>& wire) {
@@ -40,6 +59,10 @@ void Sweep::advance(const Eigen::Matrix<double, Eigen::Dynamic, 3>& wire) {
     const int mid = n / 2;
     path_length_ += (wire.row(mid).transpose() - points_[(num_rows_ - 1) * row_size_ + mid]).norm();
     num_quads_ += n - 1;
+    const int last = num_rows_ - 1;
+    strip_area_ += quadStripArea(
+        n, [&](int i) -> Eigen::Vector3d { return point(last, i); },
+        [&](int i) -> Eigen::Vector3d { return wire.row(i).transpose(); });
   }
   row_size_ = n;
   for (int i = 0; i < n; ++i) points_.push_back(wire.row(i).transpose());
@@ -73,12 +96,7 @@ void Sweep::extendedSurface(double extra_mm, Eigen::Matrix<double, Eigen::Dynami
     return;
   }
   const int n = row_size_;
-  auto row = [&](int r, int i) -> const Eigen::Vector3d& { return points_[static_cast<size_t>(r) * n + i]; };
-  auto motion = [&](int from, int to) {
-    Eigen::Vector3d d = Eigen::Vector3d::Zero();
-    for (int i = 0; i < n; ++i) d += row(to, i) - row(from, i);
-    return d.norm() > 0.0 ? Eigen::Vector3d(d.normalized()) : d;
-  };
+  auto row = [&](int r, int i) -> const Eigen::Vector3d& { return point(r, i); };
   const Eigen::Vector3d start_dir = motion(0, 1), end_dir = motion(num_rows_ - 2, num_rows_ - 1);
   const int rows = num_rows_ + 2;
   vertices.resize(static_cast<Eigen::Index>(rows) * n, 3);
@@ -97,6 +115,19 @@ void Sweep::extendedSurface(double extra_mm, Eigen::Matrix<double, Eigen::Dynami
       triangles.row(t++) << a, d, c;
     }
   }
+}
+
+double Sweep::extendedArea(double extra_mm) const {
+  if (num_rows_ < 2) return 0.0;
+  const int n = row_size_, last = num_rows_ - 1;
+  const Eigen::Vector3d start = extra_mm * motion(0, 1), end = extra_mm * motion(last - 1, last);
+  return strip_area_ +
+         quadStripArea(
+             n, [&](int i) -> Eigen::Vector3d { return point(0, i) - start; },
+             [&](int i) -> Eigen::Vector3d { return point(0, i); }) +
+         quadStripArea(
+             n, [&](int i) -> Eigen::Vector3d { return point(last, i); },
+             [&](int i) -> Eigen::Vector3d { return point(last, i) + end; });
 }
 
 double Sweep::area() const {

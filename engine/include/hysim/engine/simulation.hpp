@@ -11,6 +11,7 @@
 #include "hysim/engine/collision.hpp"
 #include "hysim/engine/outer_wall.hpp"
 #include "hysim/engine/chips.hpp"
+#include "hysim/engine/mesh_faces.hpp"
 #include "hysim/engine/scene.hpp"
 #include "hysim/engine/tet_locator.hpp"
 #include "hysim/engine/tool.hpp"
@@ -165,6 +166,21 @@ class Simulation {
   // boundary (FCL), else whether the wire is buried (one point in a tet).
   bool loopTouchesTissue();
   void finishPass();
+  // The cut surface in the rest shape, built while the pass runs: each new sweep row that lies
+  // 0.3 mm or more (its middle point) from the last kept one is carried from the tissue as it
+  // is at that step to the rest shape (mapToRest), so the cut follows the material the wire
+  // passed through when it passed. The first call also maps the row 1.5 mm before the start.
+  void mapSweepRows();
+  // Rest position of the point p of the deformed tissue: through the tet that contains it
+  // (state_.x), else the affine map of a tet at the nearest surface node, which continues the
+  // deformation smoothly. False when there is no tissue to map to.
+  bool mapToRest(const Eigen::Vector3d& p, double displacement, Eigen::Vector3d& rest) const;
+  // Appends row `row` of the sweep (or, with `shift`, that row moved by it) to rest_rows_.
+  bool mapRow(int row, const Eigen::Vector3d& shift);
+  // The lookups mapToRest needs besides the locator, for mesh_ at positions x: the nearest
+  // surface node (over a copy of x, surface_nodes_) and a tet at each node. Built with the
+  // locator (after a pass: on its background thread).
+  void buildNearest(const cutting::TetMesh& mesh, const sim::NodeVectors& x);
   void checkPerforation();
 
   Scene scene_;
@@ -204,6 +220,13 @@ class Simulation {
   void waitLocator() const;
   Eigen::Matrix<double, Eigen::Dynamic, 3> wire_, previous_wire_;
   Sweep sweep_;
+  std::vector<Eigen::Vector3d> rest_rows_;  // the open pass's kept rows, rest shape (mapSweepRows)
+  int swept_rows_mapped_ = 0;               // sweep rows looked at by mapSweepRows
+  Eigen::Vector3d kept_middle_{0, 0, 0};    // deformed middle point of the last kept row
+  bool map_failed_ = false;                 // a point had no tissue to map to
+  sim::NodeVectors nearest_x_;              // positions the NearestPoint grid was built at
+  NearestPoint nearest_surface_;            // over surface_nodes_ at nearest_x_
+  std::vector<int> node_tet_;               // #N: a tet around each node (the last that has it)
   bool loop_in_tissue_ = false;
   bool cutting_ = false;
   int topology_version_ = 0;

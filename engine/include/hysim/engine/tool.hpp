@@ -45,6 +45,16 @@ class Sweep {
   void extendedSurface(double extra_mm, Eigen::Matrix<double, Eigen::Dynamic, 3>& vertices,
                        Eigen::Matrix<int, Eigen::Dynamic, 3>& triangles) const;
   double pathLength() const { return path_length_; }  // of the wire's middle point, mm
+  int numRows() const { return num_rows_; }
+  int rowSize() const { return row_size_; }
+  const Eigen::Vector3d& point(int row, int i) const { return points_[static_cast<size_t>(row) * row_size_ + i]; }
+  // Unit mean direction of the wire's points from row `from` to row `to` (zero: no motion).
+  Eigen::Vector3d motion(int from, int to) const;
+  // Area of the strips between consecutive rows (the triangles() surface), summed as the rows
+  // came in, mm^2.
+  double stripArea() const { return strip_area_; }
+  // Area of extendedSurface(extra_mm)'s triangles, mm^2.
+  double extendedArea(double extra_mm) const;
 
  private:
   std::vector<Eigen::Vector3d> points_;  // consecutive wire positions, row after row
@@ -52,6 +62,7 @@ class Sweep {
   int num_rows_ = 0;
   int num_quads_ = 0;
   double path_length_ = 0.0;
+  double strip_area_ = 0.0;
 };
 
 }  // namespace hysim::engine
