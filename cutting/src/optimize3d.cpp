@@ -220,6 +220,34 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   // edge, all together within move_volume_budget of the mesh's volume.
   VolumeBudget moveBudget{meshVolume * options.move_volume_budget, churnFactor};
   const double refVolume = curved && options.collapse_volume_fraction_of_edge_tet ? edgeTet : 0.0;
+  // Per material (collapse_material_limit): matVol gathers, per label, (before, after) of the
+  // star's tets (a tet keeps its label, a dying tet's volume goes); matFits checks each against
+  // collapse_volume_fraction of its own part or of the whole star (starBefore).
+  struct MatVol {
+    std::int32_t m;
+    double before, after;
+  };
+  std::vector<MatVol> matVol;
+  matVol.reserve(8);
+  auto matAdd = [&](int t, double before, double after) {
+    const std::int32_t m = mesh.material(t);
+    for (MatVol& e : matVol)
+      if (e.m == m) {
+        e.before += before;
+        e.after += after;
+        return;
+      }
+    matVol.push_back({m, before, after});
+  };
+  using MaterialLimit = Optimize3DOptions::MaterialLimit;
+  auto matFits = [&](double starBefore) {
+    if (!curved || options.collapse_material_limit == MaterialLimit::Off || matVol.size() < 2) return true;
+    for (const MatVol& e : matVol) {
+      const double ref = options.collapse_material_limit == MaterialLimit::OwnPart ? e.before : starBefore;
+      if (std::abs(e.after - e.before) > options.collapse_volume_fraction * std::max(ref, refVolume)) return false;
+    }
+    return true;
+  };
   auto pos = [&](int i) -> Vec3 { return mesh.X.row(i).transpose(); };
   // q* of tet t, cached per tet with the node indices and the nodes' versions it was computed
   // from (nodeVer[n] counts the writes of n's position here; a hit needs the same nodes, none
@@ -1094,15 +1122,25 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
         if (!ok) continue;
         // Volume: the removed tets and the change of the others, against u's star.
         double before = 0, after = 0;
-        for (int t : dying) before += tetVolumeHere(mesh, t);
+        matVol.clear();
+        for (int t : dying) {
+          const double vt = tetVolumeHere(mesh, t);
+          before += vt;
+          matAdd(t, vt, 0.0);
+        }
         for (int t : changing) {
-          before += tetVolumeHere(mesh, t);
+          const double vt = tetVolumeHere(mesh, t);
+          before += vt;
           Vec3 p[4];
           for (int k = 0; k < 4; ++k) p[k] = mesh.T(t, k) == u ? pos(v) : pos(mesh.T(t, k));
-          after += (p[1] - p[0]).dot((p[2] - p[0]).cross(p[3] - p[0])) / 6.0;
+          const double vol = (p[1] - p[0]).dot((p[2] - p[0]).cross(p[3] - p[0])) / 6.0;
+          after += vol;
+          matAdd(t, vt, vol);
         }
         const double change = std::abs(after - before);
-        if (change > options.collapse_volume_fraction * std::max(before, refVolume) || !budget.fits(after - before)) continue;
+        if (change > options.collapse_volume_fraction * std::max(before, refVolume) || !budget.fits(after - before) ||
+            !matFits(before))
+          continue;
         double oldMin = 1.0;
         for (int t : dying) oldMin = std::min(oldMin, tetQ(t));
         for (int t : changing) oldMin = std::min(oldMin, tetQ(t));
@@ -1284,6 +1322,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       changing.clear();
       double oldMin = 1.0, newMin = 1.0, before = 0, after = 0;
       int worstTet = -1;
+      matVol.clear();
       for (int t : tets) {
         int onAfter = 0;
         Vec3 p[4];
@@ -1295,13 +1334,16 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
             if (group[g] == v) p[k] = groupTo[g];
         }
         oldMin = std::min(oldMin, tetQ(t));
-        before += tetVolumeHere(mesh, t);
+        const double vt = tetVolumeHere(mesh, t);
+        before += vt;
         if (onAfter == 4) {
           dying.push_back(t);
+          matAdd(t, vt, 0.0);
           continue;
         }
         changing.push_back(t);
         const double vol = (p[1] - p[0]).dot((p[2] - p[0]).cross(p[3] - p[0])) / 6.0;
+        matAdd(t, vt, vol);
         const double q = vol > 0 ? radiusRatioHere(p[0], p[1], p[2], p[3]) : -1.0;
         if (q < newMin) {
           newMin = q;
@@ -1318,7 +1360,8 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
         }
       }
       if (dying.empty() || changing.empty() || newMin < oldMin ||
-          change > options.collapse_volume_fraction * std::max(before, refVolume) || !budget.fits(after - before)) {
+          change > options.collapse_volume_fraction * std::max(before, refVolume) || !budget.fits(after - before) ||
+          !matFits(before)) {
         return false;
       }
       groupFrom.clear();

@@ -99,6 +99,17 @@ struct Optimize3DOptions {
   double collapse_volume_fraction = 0.1;  // a collapse changes its star's volume by at most this
   // ... of the star or, where the star is smaller, of a regular tet with the cut's local edge.
   bool collapse_volume_fraction_of_edge_tet = true;
+  // Collapses and snaps (on and off the cut) also bound each material's change: per material
+  // label, the volume of its tets in the star (a changed tet keeps its label, a dying tet's
+  // volume goes) changes by at most collapse_volume_fraction of the reference below. Without
+  // it a collapse or snap across the myoma/myometrium interface moves the interface while
+  // keeping the total (the default scene turned ~200 mm3 of myoma into myometrium that way).
+  //   Off:     no per-material limit (the total's limit only).
+  //   OwnPart: that material's part of the star (or the edge tet, as above).
+  //   Star:    the whole star (or the edge tet), as the total's limit: a small sliver of
+  //            another material in the star does not block the operation.
+  enum class MaterialLimit { Off, OwnPart, Star };
+  MaterialLimit collapse_material_limit = MaterialLimit::OwnPart;
   double volume_budget = 5e-4;  // peeling + collapses change the mesh volume by at most this (relative)
   // Curved cuts: volume_budget and move_volume_budget bound the net change of the volume
   // (collapses and moves add and remove volume locally); the sum of the absolute changes
