@@ -123,26 +123,6 @@ double radiusRatio(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eig
   return std::isfinite(q) ? q : 0.0;
 }
 
-double radiusRatio(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c,
-                   const Eigen::Vector3d& d) {
-  // r_in = 3V / S (S = total face area). The circumradius from the six edge lengths:
-  //   R = sqrt((p+q+r)(p+q-r)(p-q+r)(-p+q+r)) / (24 V)
-  // with p, q, r the products of the lengths of opposite edge pairs. Hence
-  //   q* = r_in / R = 72 V^2 / (S sqrt(...)).
-  const double volume = std::abs((b - a).dot((c - a).cross(d - a))) / 6.0;
-  const double p = (b - a).norm() * (d - c).norm();
-  const double q = (c - a).norm() * (d - b).norm();
-  const double r = (d - a).norm() * (c - b).norm();
-  // Rounding can push a factor of a degenerate tet slightly below zero; clamp it.
-  const double product = std::max(0.0, (p + q + r) * (p + q - r) * (p - q + r) * (-p + q + r));
-  const double faceArea = 0.5 * ((b - a).cross(c - a).norm() + (b - a).cross(d - a).norm() +
-                                 (c - a).cross(d - a).norm() + (c - b).cross(d - b).norm());
-  const double denominator = faceArea * std::sqrt(product);
-  if (!(denominator > 0) || !std::isfinite(denominator)) return 0.0;
-  const double ratio = 72.0 * volume * volume / denominator;
-  return std::isfinite(ratio) ? ratio : 0.0;
-}
-
 double minDihedralDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c,
                       const Eigen::Vector3d& d) {
   // Face normals n[k] of the face opposite vertex k, all outward for a positive tet (all

@@ -47,22 +47,6 @@ namespace {
 using Vec3 = Eigen::Vector3d;
 constexpr int kFace[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
 
-// radiusRatio (mesh_stats.cpp) with the same expressions in the same order, here where the
-// compiler can inline it (the optimiser's hot loops evaluate it millions of times).
-inline double radiusRatioHere(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
-  const double volume = std::abs((b - a).dot((c - a).cross(d - a))) / 6.0;
-  const double p = (b - a).norm() * (d - c).norm();
-  const double q = (c - a).norm() * (d - b).norm();
-  const double r = (d - a).norm() * (c - b).norm();
-  const double product = std::max(0.0, (p + q + r) * (p + q - r) * (p - q + r) * (-p + q + r));
-  const double faceArea = 0.5 * ((b - a).cross(c - a).norm() + (b - a).cross(d - a).norm() +
-                                 (c - a).cross(d - a).norm() + (c - b).cross(d - b).norm());
-  const double denominator = faceArea * std::sqrt(product);
-  if (!(denominator > 0) || !std::isfinite(denominator)) return 0.0;
-  const double ratio = 72.0 * volume * volume / denominator;
-  return std::isfinite(ratio) ? ratio : 0.0;
-}
-
 // tetVolume (mesh.cpp) inlined, in scalars over the coordinate columns: Eigen's cross
 // (y1 z2 - z1 y2, z1 x2 - x1 z2, x1 y2 - y1 x2) and 3-vector dot ((a0 b0 + a1 b1) + a2 b2),
 // the same expression and value as the mesh volume below (checked there bit for bit).
@@ -284,7 +268,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       slot = static_cast<std::int32_t>(qPool.size());
       qPool.emplace_back();
     }
-    cur.q = radiusRatioHere(pos(cur.v[0]), pos(cur.v[1]), pos(cur.v[2]), pos(cur.v[3]));
+    cur.q = radiusRatio(pos(cur.v[0]), pos(cur.v[1]), pos(cur.v[2]), pos(cur.v[3]));
     qPool[slot] = cur;
     return cur.q;
   };
@@ -293,7 +277,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     Vec3 p[4];
     for (int k = 0; k < 4; ++k) p[k] = mesh.T(t, k) == n ? y : pos(mesh.T(t, k));
     if (!((p[1] - p[0]).dot((p[2] - p[0]).cross(p[3] - p[0])) > 0)) return -1.0;
-    return radiusRatioHere(p[0], p[1], p[2], p[3]);
+    return radiusRatio(p[0], p[1], p[2], p[3]);
   };
   // Worst q* around n where it is (tetQAt at its own position, through the cache).
   auto starWorst = [&](int n, int* worstTet) {
@@ -721,7 +705,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       return (pos(b) - p0).dot((pos(c) - p0).cross(pos(d) - p0));
     };
     auto q4 = [&](int a, int b, int c, int d) {
-      return vol6(a, b, c, d) > 0 ? radiusRatioHere(pos(a), pos(b), pos(c), pos(d)) : -1.0;
+      return vol6(a, b, c, d) > 0 ? radiusRatio(pos(a), pos(b), pos(c), pos(d)) : -1.0;
     };
     auto setTet = [&](int t, int a, int b, int c, int d) {
       const int v[4] = {a, b, c, d};
@@ -1344,7 +1328,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
         changing.push_back(t);
         const double vol = (p[1] - p[0]).dot((p[2] - p[0]).cross(p[3] - p[0])) / 6.0;
         matAdd(t, vt, vol);
-        const double q = vol > 0 ? radiusRatioHere(p[0], p[1], p[2], p[3]) : -1.0;
+        const double q = vol > 0 ? radiusRatio(p[0], p[1], p[2], p[3]) : -1.0;
         if (q < newMin) {
           newMin = q;
           worstTet = t;
