@@ -18,6 +18,21 @@
 namespace {
 using namespace hysim;
 
+// Pass i (from 1) of $HYSIM_REPLAY_DIR: its mesh and cut surface; false when there is no
+// such pass (or no folder).
+bool readDumpedPass(int i, cutting::TetMesh& mesh, cutting::TriMesh& surface) {
+  const char* dir = std::getenv("HYSIM_REPLAY_DIR");
+  if (dir == nullptr) return false;
+  char name[32];
+  std::snprintf(name, sizeof(name), "/pass_%03d_", i);
+  auto m = cutting::readTetMesh(std::string(dir) + name + "mesh.msh");
+  auto tri = cutting::readTriMesh(std::string(dir) + name + "surface.msh");
+  if (!m.ok() || !tri.ok()) return false;
+  mesh = std::move(*m);
+  surface = std::move(*tri);
+  return true;
+}
+
 std::vector<cutting::TetMesh>& meshes() {
   static std::vector<cutting::TetMesh> all;
   static bool loaded = false;
@@ -81,17 +96,12 @@ void BM_Locate(benchmark::State& state) {
   };
   static std::vector<Pass> passes = [] {
     std::vector<Pass> out;
-    const char* dir = std::getenv("HYSIM_REPLAY_DIR");
-    if (dir == nullptr) return out;
-    for (int i = 1;; ++i) {
-      char name[32];
-      std::snprintf(name, sizeof(name), "/pass_%03d_", i);
-      auto m = cutting::readTetMesh(std::string(dir) + name + "mesh.msh");
-      auto tri = cutting::readTriMesh(std::string(dir) + name + "surface.msh");
-      if (!m.ok() || !tri.ok()) break;
+    cutting::TetMesh mesh;
+    cutting::TriMesh surface;
+    for (int i = 1; readDumpedPass(i, mesh, surface); ++i) {
       Pass p;
-      p.mesh = std::move(*m);
-      p.points = tri->X;
+      p.mesh = std::move(mesh);
+      p.points = surface.X;
       p.x = p.mesh.X;
       p.locator.build(p.mesh, p.x);
       out.push_back(std::move(p));
@@ -127,22 +137,17 @@ void BM_FacesPieces(benchmark::State& state) {
   };
   static std::vector<Pass> passes = [] {
     std::vector<Pass> out;
-    const char* dir = std::getenv("HYSIM_REPLAY_DIR");
-    if (dir == nullptr) return out;
-    for (int i = 1;; ++i) {
-      char name[32];
-      std::snprintf(name, sizeof(name), "/pass_%03d_", i);
-      auto m = cutting::readTetMesh(std::string(dir) + name + "mesh.msh");
-      auto tri = cutting::readTriMesh(std::string(dir) + name + "surface.msh");
-      if (!m.ok() || !tri.ok()) break;
-      auto s = cutting::CutSurface::triangles(tri->X, tri->F);
+    cutting::TetMesh mesh;
+    cutting::TriMesh surface;
+    for (int i = 1; readDumpedPass(i, mesh, surface); ++i) {
+      auto s = cutting::CutSurface::triangles(surface.X, surface.F);
       if (!s.ok()) break;
       cutting::Cut3DOptions o;
       o.method = cutting::CutMethod::Hybrid;
-      auto r = cutting::cut3d(*m, *s, o);
+      auto r = cutting::cut3d(mesh, *s, o);
       if (!r.ok()) break;
       Pass p;
-      p.before = std::move(*m);
+      p.before = std::move(mesh);
       p.after = std::move(r->mesh);
       p.change = std::move(r->change);
       engine::matchFaces(p.before, p.next_before);
