@@ -27,6 +27,16 @@ void checkMasses(const cutting::TetMesh& before, const cutting::TetMesh& after, 
   EXPECT_GT(report.unknowns, 0);
 }
 
+// A one-material model of `mesh` with the nodes below z = 0.5 held.
+auto modelHeldBelowHalf(const cutting::TetMesh& mesh) {
+  Material mat;
+  mat.label = 1;
+  std::vector<int> fixed;
+  for (int i = 0; i < mesh.numNodes(); ++i)
+    if (mesh.X(i, 2) < 0.5) fixed.push_back(i);
+  return buildModel(mesh, {mat}, fixed, {});
+}
+
 TEST(TissueUpdate3D, MassesKeepMomentsForEveryMethod) {
   const auto box = testing::boxTetMesh(4, 4, 4, 0.5);
   const Eigen::VectorXd m0 = lumpedMasses3D(box, Eigen::VectorXd::Constant(box.numTets(), 1e-3));
@@ -257,12 +267,7 @@ double globalOmega(const Model& model, const cutting::TetMesh& mesh) {
 TEST(TissueUpdate3D, HeldStabilityBoundStaysAboveTheGlobalEstimate) {
   for (const int max_held : {2, 0}) {
     cutting::TetMesh mesh = testing::boxTetMesh(6, 6, 6, 1.0);
-    Material mat;
-    mat.label = 1;
-    std::vector<int> fixed;
-    for (int i = 0; i < mesh.numNodes(); ++i)
-      if (mesh.X(i, 2) < 0.5) fixed.push_back(i);
-    auto built = buildModel(mesh, {mat}, fixed, {});
+    auto built = modelHeldBelowHalf(mesh);
     ASSERT_TRUE(built.ok());
     Model model = *built;
     EXPECT_EQ(model.stability_held, -1);
@@ -313,12 +318,7 @@ TEST(TissueUpdate3D, HeldStabilityBoundStaysAboveTheGlobalEstimate) {
 // an empty cut keeps every node; the overlap threshold < 0 forces the global estimate).
 TEST(TissueUpdate3D, LanczosEstimateReachesThePowerIteration) {
   const cutting::TetMesh mesh = testing::boxTetMesh(6, 5, 4, 1.0);
-  Material mat;
-  mat.label = 1;
-  std::vector<int> fixed;
-  for (int i = 0; i < mesh.numNodes(); ++i)
-    if (mesh.X(i, 2) < 0.5) fixed.push_back(i);
-  auto built = buildModel(mesh, {mat}, fixed, {});
+  auto built = modelHeldBelowHalf(mesh);
   ASSERT_TRUE(built.ok());
   Model model = *built;
   cutting::TopologyChange identity;
@@ -326,8 +326,7 @@ TEST(TissueUpdate3D, LanczosEstimateReachesThePowerIteration) {
   identity.old_num_elements = identity.new_num_elements = mesh.numTets();
   for (int i = 0; i < mesh.numNodes(); ++i) identity.node_old_to_new.push_back(i);
   for (int t = 0; t < mesh.numTets(); ++t) identity.element_old_to_new.push_back(t);
-  std::vector<std::uint8_t> flags(static_cast<size_t>(mesh.numNodes()), 0);
-  for (int i : fixed) flags[i] = 1;
+  const std::vector<std::uint8_t> flags(model.fixed.begin(), model.fixed.end());
   CutUpdate3DOptions options;
   options.mode_overlap = -1.0;
   options.max_held_estimates = 0;
@@ -348,12 +347,7 @@ TEST(TissueUpdate3D, LanczosEstimateReachesThePowerIteration) {
 // above it. The step's stability_safety (0.85) leaves 15 %.
 TEST(TissueUpdate3D, DefaultLanczosEstimateIsConverged) {
   cutting::TetMesh mesh = testing::boxTetMesh(7, 6, 5, 1.0);
-  Material mat;
-  mat.label = 1;
-  std::vector<int> fixed;
-  for (int i = 0; i < mesh.numNodes(); ++i)
-    if (mesh.X(i, 2) < 0.5) fixed.push_back(i);
-  auto built = buildModel(mesh, {mat}, fixed, {});
+  auto built = modelHeldBelowHalf(mesh);
   ASSERT_TRUE(built.ok());
   Model model = *built;
   auto estimate = [](const Model& m, const cutting::TetMesh& msh, const CutUpdate3DOptions& base, int* steps) {
