@@ -30,6 +30,7 @@
 #include "hysim/cutting/mesh_stats.hpp"
 #include "hysim/sim/model.hpp"
 #include "hysim/sim/tissue_update3d.hpp"
+#include "replay_passes.hpp"
 
 namespace {
 
@@ -322,17 +323,12 @@ struct ReplayPass {
 const std::vector<ReplayPass>& replayPasses() {
   static const std::vector<ReplayPass> passes = [] {
     std::vector<ReplayPass> out;
-    const char* dir = std::getenv("HYSIM_REPLAY_DIR");
-    if (dir == nullptr || *dir == 0) return out;
-    for (int i = 1;; ++i) {
-      char name[32];
-      std::snprintf(name, sizeof(name), "/pass_%03d_", i);
-      auto m = hysim::cutting::readTetMesh(std::string(dir) + name + "mesh.msh");
-      auto tri = hysim::cutting::readTriMesh(std::string(dir) + name + "surface.msh");
-      if (!m.ok() || !tri.ok()) break;
-      auto s = hysim::cutting::CutSurface::triangles(tri->X, tri->F);
+    hysim::cutting::TetMesh mesh;
+    hysim::cutting::TriMesh tri;
+    for (int i = 1; hysim::bench::readDumpedPass(i, mesh, tri); ++i) {
+      auto s = hysim::cutting::CutSurface::triangles(tri.X, tri.F);
       if (!s.ok()) break;
-      out.push_back({std::move(*m), std::move(*s)});
+      out.push_back({std::move(mesh), std::move(*s)});
     }
     return out;
   }();

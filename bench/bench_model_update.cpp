@@ -23,6 +23,7 @@
 #include "hysim/cutting/mesh_io.hpp"
 #include "hysim/sim/model.hpp"
 #include "hysim/sim/tissue_update3d.hpp"
+#include "replay_passes.hpp"
 
 namespace {
 
@@ -195,19 +196,15 @@ int main() {
       cases.push_back(std::move(c));
     }
   }
-  const char* dir = std::getenv("HYSIM_REPLAY_DIR");
-  if (dir != nullptr && *dir != 0) {
-    for (int i = 1;; ++i) {
-      char name[32];
-      std::snprintf(name, sizeof(name), "/pass_%03d_", i);
-      auto m = hysim::cutting::readTetMesh(std::string(dir) + name + "mesh.msh");
-      auto tri = hysim::cutting::readTriMesh(std::string(dir) + name + "surface.msh");
-      if (!m.ok() || !tri.ok()) break;
-      auto s = hysim::cutting::CutSurface::triangles(tri->X, tri->F);
+  {
+    hysim::cutting::TetMesh mesh;
+    hysim::cutting::TriMesh tri;
+    for (int i = 1; hysim::bench::readDumpedPass(i, mesh, tri); ++i) {
+      auto s = hysim::cutting::CutSurface::triangles(tri.X, tri.F);
       if (!s.ok()) break;
       Case c;
       c.name = "pass " + std::to_string(i);
-      c.before = std::move(*m);
+      c.before = std::move(mesh);
       if (!prepare(c, *s, true)) {
         std::fprintf(stderr, "pass %d: cannot prepare\n", i);
         continue;

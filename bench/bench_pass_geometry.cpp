@@ -14,24 +14,10 @@
 #include "hysim/engine/collision.hpp"
 #include "hysim/engine/mesh_faces.hpp"
 #include "hysim/engine/tet_locator.hpp"
+#include "replay_passes.hpp"
 
 namespace {
 using namespace hysim;
-
-// Pass i (from 1) of $HYSIM_REPLAY_DIR: its mesh and cut surface; false when there is no
-// such pass (or no folder).
-bool readDumpedPass(int i, cutting::TetMesh& mesh, cutting::TriMesh& surface) {
-  const char* dir = std::getenv("HYSIM_REPLAY_DIR");
-  if (dir == nullptr) return false;
-  char name[32];
-  std::snprintf(name, sizeof(name), "/pass_%03d_", i);
-  auto m = cutting::readTetMesh(std::string(dir) + name + "mesh.msh");
-  auto tri = cutting::readTriMesh(std::string(dir) + name + "surface.msh");
-  if (!m.ok() || !tri.ok()) return false;
-  mesh = std::move(*m);
-  surface = std::move(*tri);
-  return true;
-}
 
 std::vector<cutting::TetMesh>& meshes() {
   static std::vector<cutting::TetMesh> all;
@@ -98,7 +84,7 @@ void BM_Locate(benchmark::State& state) {
     std::vector<Pass> out;
     cutting::TetMesh mesh;
     cutting::TriMesh surface;
-    for (int i = 1; readDumpedPass(i, mesh, surface); ++i) {
+    for (int i = 1; bench::readDumpedPass(i, mesh, surface); ++i) {
       Pass p;
       p.mesh = std::move(mesh);
       p.points = surface.X;
@@ -139,7 +125,7 @@ void BM_FacesPieces(benchmark::State& state) {
     std::vector<Pass> out;
     cutting::TetMesh mesh;
     cutting::TriMesh surface;
-    for (int i = 1; readDumpedPass(i, mesh, surface); ++i) {
+    for (int i = 1; bench::readDumpedPass(i, mesh, surface); ++i) {
       auto s = cutting::CutSurface::triangles(surface.X, surface.F);
       if (!s.ok()) break;
       cutting::Cut3DOptions o;
