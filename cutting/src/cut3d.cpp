@@ -5,6 +5,7 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <limits>
 #include <numeric>
 #include <span>
@@ -238,6 +239,91 @@ int findLocal(const Tet& t, int v) {
 
 }  // namespace
 
+void buildStarLists(const Tets& T, int numNodes, StarLists* lists) {
+  const int M = static_cast<int>(T.rows());
+  std::vector<std::int32_t>& off = lists->off;
+  std::vector<std::int32_t>& star = lists->star;
+  // Counts at off[n + 2], their prefix sums, then each tet at off[n + 1]++: afterwards
+  // off[n] .. off[n + 1] is n's row (ascending: the tets in index order).
+  off.assign(static_cast<size_t>(numNodes) + 2, 0);
+  const std::int32_t* col[4] = {T.col(0).data(), T.col(1).data(), T.col(2).data(), T.col(3).data()};
+  for (int k = 0; k < 4; ++k)
+    for (int t = 0; t < M; ++t) ++off[col[k][t] + 2];
+  for (int i = 0; i < numNodes; ++i) off[i + 2] += off[i + 1];
+  star.resize(4 * static_cast<size_t>(M));
+  for (int t = 0; t < M; ++t)
+    for (int k = 0; k < 4; ++k) star[off[col[k][t] + 1]++] = t;
+  off.pop_back();
+  lists->pool_start.clear();
+  lists->pool_len.clear();
+  lists->pool.clear();
+}
+
+void patchStarLists(const Tets& before, const Tets& after, int numNodesAfter, std::vector<std::int32_t> changed,
+                    StarLists* lists) {
+  const int M0 = static_cast<int>(before.rows()), M1 = static_cast<int>(after.rows());
+  const int N0 = static_cast<int>(lists->off.size()) - 1;
+  std::sort(changed.begin(), changed.end());
+  changed.erase(std::unique(changed.begin(), changed.end()), changed.end());
+  std::vector<std::uint8_t> isChanged(M0, 0);
+  for (const int t : changed) isChanged[t] = 1;
+  // The nodes whose lists change (those of the changed tets before and after, and of the
+  // appended tets), numbered as met; for each, the changed and appended tets that have it
+  // now (CSR over those numbers, ascending: the tets are visited in index order).
+  std::vector<std::int32_t> local(numNodesAfter, -1), nodes, count;
+  auto number = [&](std::int32_t n) {
+    if (local[n] < 0) {
+      local[n] = static_cast<std::int32_t>(nodes.size());
+      nodes.push_back(n);
+      count.push_back(0);
+    }
+    return local[n];
+  };
+  for (const int t : changed)
+    for (int k = 0; k < 4; ++k) {
+      number(before(t, k));
+      ++count[number(after(t, k))];
+    }
+  for (int t = M0; t < M1; ++t)
+    for (int k = 0; k < 4; ++k) ++count[number(after(t, k))];
+  std::vector<std::int32_t> gainedOff(nodes.size() + 1, 0), gained;
+  for (size_t i = 0; i < nodes.size(); ++i) gainedOff[i + 1] = gainedOff[i] + count[i];
+  gained.resize(gainedOff.back());
+  for (size_t i = 0; i < nodes.size(); ++i) count[i] = gainedOff[i];  // fill positions
+  for (const int t : changed)
+    for (int k = 0; k < 4; ++k) gained[count[local[after(t, k)]]++] = t;
+  for (int t = M0; t < M1; ++t)
+    for (int k = 0; k < 4; ++k) gained[count[local[after(t, k)]]++] = t;
+  // Appended nodes: empty CSR rows.
+  lists->off.resize(static_cast<size_t>(numNodesAfter) + 1, lists->off[N0]);
+  lists->pool_start.assign(numNodesAfter, -1);
+  lists->pool_len.assign(numNodesAfter, 0);
+  std::vector<std::int32_t>& pool = lists->pool;
+  pool.clear();
+  pool.reserve(gained.size() + 8 * nodes.size());
+  for (size_t i = 0; i < nodes.size(); ++i) {
+    // Merge n's old row without the changed tets and the tets that now have n.
+    const int n = nodes[i];
+    const std::int32_t* o = n < N0 ? lists->star.data() + lists->off[n] : nullptr;
+    const std::int32_t* oEnd = n < N0 ? lists->star.data() + lists->off[n + 1] : nullptr;
+    const std::int32_t* g = gained.data() + gainedOff[i];
+    const std::int32_t* gEnd = gained.data() + gainedOff[i + 1];
+    const size_t start = pool.size();
+    for (;;) {
+      while (o < oEnd && isChanged[*o]) ++o;
+      const bool haveOld = o < oEnd, haveNew = g < gEnd;
+      if (!haveOld && !haveNew) break;
+      if (haveOld && (!haveNew || *o < *g)) {
+        pool.push_back(*o++);
+      } else {
+        pool.push_back(*g++);
+      }
+    }
+    lists->pool_start[n] = static_cast<std::int32_t>(start);
+    lists->pool_len[n] = static_cast<std::int32_t>(pool.size() - start);
+  }
+}
+
 double totalVolume(const TetMesh& mesh) {
   double v = 0;
   for (int t = 0; t < mesh.numTets(); ++t) v += tetVolume(mesh, t);
@@ -384,45 +470,16 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
   // arrays are not copied as they grow (a guess; they still grow past it if needed).
   Work w(input, 4 * crossed.size() + 64, 12 * crossed.size() + 64);
 
-  // Node -> tets (CSR) of the input mesh, complete (all tets, ascending) for the nodes within
-  // one edge step of the crossed tets and the nodes on the surface: the only stars the steps
-  // below look at (snap/away/route candidates are ends of crossed edges, feature tests look
-  // at their neighbours, subdivision and separation at the crossed tets and the nodes on the
-  // cut). Two passes over the tets mark those nodes and the tets around them.
-  std::vector<std::int32_t> starOff(N0 + 1, 0), starTet;
-  {
-    std::vector<std::uint8_t> near(N0, 0);
-    for (int t : crossedTets)
-      for (int k = 0; k < 4; ++k) near[input.T(t, k)] = 1;
-    for (int n : onNodes) near[n] = 1;
-    const std::int32_t* T0c[4] = {input.T.col(0).data(), input.T.col(1).data(), input.T.col(2).data(),
-                                  input.T.col(3).data()};
-    for (int t = 0; t < M0; ++t) {
-      const int a = T0c[0][t], b = T0c[1][t], c = T0c[2][t], d = T0c[3][t];
-      if ((near[a] | near[b] | near[c] | near[d]) & 1) {
-        near[a] |= 2;
-        near[b] |= 2;
-        near[c] |= 2;
-        near[d] |= 2;
-      }
-    }
-    std::vector<std::int32_t> around;  // tets with a node marked (either flag)
-    for (int t = 0; t < M0; ++t) {
-      const int a = T0c[0][t], b = T0c[1][t], c = T0c[2][t], d = T0c[3][t];
-      if (near[a] | near[b] | near[c] | near[d]) {
-        around.push_back(t);
-        ++starOff[a + 1];
-        ++starOff[b + 1];
-        ++starOff[c + 1];
-        ++starOff[d + 1];
-      }
-    }
-    for (int i = 0; i < N0; ++i) starOff[i + 1] += starOff[i];
-    starTet.resize(starOff[N0]);
-    std::vector<std::int32_t> fill(starOff.begin(), starOff.end() - 1);
-    for (int t : around)
-      for (int k = 0; k < 4; ++k) starTet[fill[T0c[k][t]]++] = t;
-  }
+  // Node -> tets (CSR) of the input mesh, all tets, each list ascending. The steps below look
+  // only at the stars within one edge step of the crossed tets and of the nodes on the surface
+  // (snap/away/route candidates are ends of crossed edges, feature tests look at their
+  // neighbours, subdivision and separation at the crossed tets and the nodes on the cut); the
+  // optimisation takes the lists over, patched where the cut changed tets (one O(#T) build
+  // for both).
+  StarLists stars;
+  buildStarLists(input.T, N0, &stars);
+  const std::vector<std::int32_t>& starOff = stars.off;
+  const std::vector<std::int32_t>& starTet = stars.star;
 
   auto crossingPoint = [&](const CrossedEdge& e) -> Vec3 {
     if (!plane) return e.point;
@@ -1187,6 +1244,22 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
     for (const auto& ce : crossed)
       region.edge_length += (input.X.row(ce.a) - input.X.row(ce.b)).norm() / static_cast<double>(crossed.size());
     region.seeds.insert(region.seeds.end(), moved.begin(), moved.end());
+    // The input's lists, patched to the output mesh (the rows the cut wrote, the appended
+    // tets); the optimisation takes them over.
+    patchStarLists(input.T, out.T, N1, std::move(w.changedTets), &stars);
+#ifdef HYSIM_CHECK_EXACT
+    {
+      StarLists full;
+      buildStarLists(out.T, N1, &full);
+      for (int i = 0; i < N1; ++i) {
+        const std::int32_t* b = stars.pool_start[i] >= 0 ? stars.pool.data() + stars.pool_start[i] : stars.star.data() + stars.off[i];
+        const size_t len = stars.pool_start[i] >= 0 ? stars.pool_len[i] : stars.off[i + 1] - stars.off[i];
+        if (len != static_cast<size_t>(full.off[i + 1] - full.off[i]) || !std::equal(b, b + len, full.star.data() + full.off[i]))
+          std::abort();
+      }
+    }
+#endif
+    region.stars = &stars;
     const size_t before = moved.size();
     OptimizeCounts counts;
     optimizeAroundCut(out, region, options.optimize, &moved, &peeled, &counts);

@@ -106,11 +106,25 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   const double cosRidge = std::cos(options.ridge_deg * M_PI / 180.0);
   std::vector<std::array<Vec3, 3>> fan;  // constraintOf's Fan: the node's boundary faces
 
-  // Node -> tets of the whole mesh (one O(#T) pass; everything else is local), live tets in
-  // index order. After edge collapses the lists of the nodes whose tets died or changed are
-  // rebuilt (buildStars), into `ovrPool`; the others keep their CSR rows.
-  std::vector<std::int32_t> off(N + 1, 0), star(4 * static_cast<size_t>(M));
-  std::vector<std::int32_t> ovrStart(N, -1), ovrLen(N, 0), ovrPool;
+  // Node -> tets of the whole mesh (one O(#T) pass, or taken over from region.stars;
+  // everything else is local), live tets in index order. After edge collapses the lists of
+  // the nodes whose tets died or changed are rebuilt (buildStars), into `ovrPool`; the others
+  // keep their CSR rows.
+  std::vector<std::int32_t> off, star, ovrStart, ovrLen, ovrPool;
+  bool built = false;
+  if (region.stars != nullptr) {
+    off.swap(region.stars->off);
+    star.swap(region.stars->star);
+    ovrStart.swap(region.stars->pool_start);
+    ovrLen.swap(region.stars->pool_len);
+    ovrPool.swap(region.stars->pool);
+    built = true;
+  } else {
+    off.assign(N + 1, 0);
+    star.resize(4 * static_cast<size_t>(M));
+    ovrStart.assign(N, -1);
+    ovrLen.assign(N, 0);
+  }
   std::vector<std::uint8_t> touched(N, 0);
   std::vector<std::int32_t> touchedList;
   std::vector<std::pair<std::int32_t, std::int32_t>> gained;  // (node, tet): tet took the node
@@ -129,7 +143,6 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     killed.push_back(t);
     for (int k = 0; k < 4; ++k) touch(mesh.T(t, k));
   };
-  bool built = false;
   std::vector<std::int32_t> scratch;
   auto buildStars = [&]() {
     if (!built) {

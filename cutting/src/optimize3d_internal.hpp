@@ -9,12 +9,30 @@
 
 namespace hysim::cutting {
 
+// Node -> tet lists of a tet mesh (each list ascending): CSR rows (off, star), or, where
+// pool_start[n] >= 0, pool_len[n] entries of `pool` from there.
+struct StarLists {
+  std::vector<std::int32_t> off, star;
+  std::vector<std::int32_t> pool_start, pool_len, pool;
+};
+// The CSR rows of all numNodes nodes of T (pool empty).
+void buildStarLists(const Tets& T, int numNodes, StarLists* lists);
+// `lists` holds the lists of `before`; `after` is the same mesh with the rows `changed` (below
+// before.rows(), may repeat) rewritten and rows appended, with numNodesAfter nodes (nodes
+// appended too). Afterwards `lists` holds the lists of `after`: the rows of the nodes of the
+// changed and appended tets go to the pool; the others keep their CSR rows.
+void patchStarLists(const Tets& before, const Tets& after, int numNodesAfter, std::vector<std::int32_t> changed,
+                    StarLists* lists);
+
 struct CutRegion {
   const CutSurface* surface = nullptr;
   double eps = 0;                       // on-surface tolerance (absolute)
   std::vector<std::int32_t> seeds;      // nodes the cut created, moved or separated
   std::vector<std::uint8_t> on_cut;     // #N of the output mesh: node lies on the cut
   double edge_length = 0;               // mean length of the crossed edges (the local mesh size)
+  // Optional: the output mesh's node -> tet lists (cut3d: the input's, patched where the cut
+  // changed tets), which optimizeAroundCut takes over (moved from) instead of building them.
+  StarLists* stars = nullptr;
 };
 
 struct OptimizeCounts {
