@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <limits>
 #include <numeric>
 #include <span>
@@ -246,13 +247,23 @@ void buildStarLists(const Tets& T, int numNodes, StarLists* lists) {
   // Counts at off[n + 2], their prefix sums, then each tet at off[n + 1]++: afterwards
   // off[n] .. off[n + 1] is n's row (ascending: the tets in index order).
   off.assign(static_cast<size_t>(numNodes) + 2, 0);
-  const std::int32_t* col[4] = {T.col(0).data(), T.col(1).data(), T.col(2).data(), T.col(3).data()};
-  for (int k = 0; k < 4; ++k)
-    for (int t = 0; t < M; ++t) ++off[col[k][t] + 2];
-  for (int i = 0; i < numNodes; ++i) off[i + 2] += off[i + 1];
   star.resize(4 * static_cast<size_t>(M));
-  for (int t = 0; t < M; ++t)
-    for (int k = 0; k < 4; ++k) star[off[col[k][t] + 1]++] = t;
+  const std::int32_t *c0 = T.col(0).data(), *c1 = T.col(1).data(), *c2 = T.col(2).data(), *c3 = T.col(3).data();
+  std::int32_t* o = off.data();
+  std::int32_t* s = star.data();
+  for (int t = 0; t < M; ++t) {
+    ++o[c0[t] + 2];
+    ++o[c1[t] + 2];
+    ++o[c2[t] + 2];
+    ++o[c3[t] + 2];
+  }
+  for (int i = 0; i < numNodes; ++i) o[i + 2] += o[i + 1];
+  for (int t = 0; t < M; ++t) {
+    s[o[c0[t] + 1]++] = t;
+    s[o[c1[t] + 1]++] = t;
+    s[o[c2[t] + 1]++] = t;
+    s[o[c3[t] + 1]++] = t;
+  }
   off.pop_back();
   lists->pool_start.clear();
   lists->pool_len.clear();
@@ -1284,24 +1295,51 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
   const bool anyPeeled = std::find(peeled.begin(), peeled.end(), 1) != peeled.end();
   if (deleting || anyPeeled) {
     // Compact: drop deleted and peeled tets and the nodes no longer used.
-    auto dropped = [&](int t) { return (t < M0 && deleting && deleted[t]) || (anyPeeled && peeled[t]); };
-    std::vector<std::int32_t> tetMap(M1, -1), nodeMap(N1, -1), drop;
-    int mt = 0;
-    for (int t = 0; t < M1; ++t) {
-      if (!dropped(t)) {
-        tetMap[t] = mt++;
-      } else {
-        drop.push_back(t);
+    std::vector<std::int32_t> drop;  // ascending
+    if (deleting) {
+      for (int t = 0; t < M1; ++t)
+        if ((t < M0 && deleted[t]) || (anyPeeled && peeled[t])) drop.push_back(t);
+    } else {
+      // Peeled slivers only (few): found by memchr over the flags.
+      const std::uint8_t* p = peeled.data();
+      for (const std::uint8_t* q = p; (q = static_cast<const std::uint8_t*>(std::memchr(q, 1, p + M1 - q))) != nullptr; ++q)
+        drop.push_back(static_cast<std::int32_t>(q - p));
+    }
+    const int mt = M1 - static_cast<int>(drop.size());
+    // tetMap: kept tets in runs between the dropped ones, each shifted down by the number of
+    // dropped tets before it.
+    std::vector<std::int32_t> tetMap(M1);
+    {
+      std::int32_t* m = tetMap.data();
+      int src = 0;
+      for (size_t g = 0; g <= drop.size(); ++g) {
+        const int end = g < drop.size() ? drop[g] : M1;
+        const std::int32_t shift = static_cast<std::int32_t>(g);
+        for (int t = src; t < end; ++t) m[t] = t - shift;
+        if (end < M1) m[end] = -1;
+        src = end + 1;
       }
     }
     // Uses of each node by the kept tets (all uses minus those of the dropped tets): a node
     // no kept tet uses goes.
-    for (int k = 0; k < 4; ++k) {
-      const std::int32_t* col = out.T.col(k).data();
-      for (int t = 0; t < M1; ++t) ++nodeMap[col[t]];  // from -1: uses - 1
+    std::vector<std::int32_t> nodeMap(N1, -1);
+    {
+      std::int32_t* u = nodeMap.data();
+      const std::int32_t *c0 = out.T.col(0).data(), *c1 = out.T.col(1).data(), *c2 = out.T.col(2).data(),
+                         *c3 = out.T.col(3).data();
+      for (int t = 0; t < M1; ++t) {  // from -1: uses - 1
+        ++u[c0[t]];
+        ++u[c1[t]];
+        ++u[c2[t]];
+        ++u[c3[t]];
+      }
+      for (const int t : drop) {
+        --u[c0[t]];
+        --u[c1[t]];
+        --u[c2[t]];
+        --u[c3[t]];
+      }
     }
-    for (int t : drop)
-      for (int k = 0; k < 4; ++k) --nodeMap[out.T(t, k)];
     int mn = 0;
     for (int i = 0; i < N1; ++i) nodeMap[i] = nodeMap[i] >= 0 ? mn++ : -1;
     // Kept rows in runs between the dropped tets (nodes likewise).
@@ -1317,9 +1355,9 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
     TetMesh compact;
     compact.T.resize(mt, 4);
     compact.material.resize(mt);
-    keepRows(out.T, compact.T, drop);
     keepRows(out.material, compact.material, drop);
     if (mn == N1) {
+      keepRows(out.T, compact.T, drop);
       compact.X = std::move(out.X);
     } else {
       std::vector<std::int32_t> gone;
@@ -1327,17 +1365,36 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
         if (nodeMap[i] < 0) gone.push_back(i);
       compact.X.resize(mn, 3);
       keepRows(out.X, compact.X, gone);
+      // The kept tets' rows, renumbered as they are copied.
+      const std::int32_t* map = nodeMap.data();
       for (int k = 0; k < 4; ++k) {
-        std::int32_t* col = compact.T.col(k).data();
-        for (int t = 0; t < mt; ++t) col[t] = nodeMap[col[t]];
+        const std::int32_t* from = out.T.col(k).data();
+        std::int32_t* to = compact.T.col(k).data();
+        int src = 0, dst = 0;
+        for (size_t g = 0; g <= drop.size(); ++g) {
+          const int end = g < drop.size() ? drop[g] : M1;
+          for (int t = src; t < end; ++t) to[dst++] = map[from[t]];
+          src = end + 1;
+        }
       }
     }
     out = std::move(compact);
     for (int i = 0; i < N0; ++i) change.node_old_to_new[i] = nodeMap[i];
-    for (int t = 0; t < M0; ++t) {
-      const int was = change.element_old_to_new[t];
-      change.element_old_to_new[t] = was >= 0 ? tetMap[was] : -1;
-      if (was >= 0 && tetMap[was] < 0) change.removed_elements.push_back(t);
+    // Old tets: each is its own index or -1 (split) so far; kept ones shift down with tetMap
+    // (in runs), dropped ones go.
+    {
+      std::int32_t* e = change.element_old_to_new.data();
+      int src = 0;
+      for (size_t g = 0; g <= drop.size() && src < M0; ++g) {
+        const int end = g < drop.size() ? std::min(drop[g], M0) : M0;
+        const std::int32_t shift = static_cast<std::int32_t>(g);
+        for (int t = src; t < end; ++t) e[t] = e[t] >= 0 ? t - shift : -1;
+        if (end < M0) {
+          if (e[end] >= 0) change.removed_elements.push_back(end);
+          e[end] = -1;
+        }
+        src = end + 1;
+      }
     }
     std::sort(change.removed_elements.begin(), change.removed_elements.end());
     auto remapList = [&](std::vector<std::int32_t>& list, const std::vector<std::int32_t>& map) {
