@@ -11,14 +11,10 @@
 #include "model_internal.hpp"
 
 namespace hysim::sim {
-namespace {
 
-// The largest eigenvalue of the symmetric tridiagonal matrix (diag, sub), by Newton's method
-// on its characteristic polynomial from above (from the Gershgorin bound: every root is
-// real, so the iterates decrease monotonically to the largest), with the pivots of
-// T - x I as the Sturm sequence. Returns NaN when it does not settle (then the caller asks
-// a full eigenvalue solver). Accurate to a few units in the last place of the matrix's
-// norm; the dense solver's value can differ in those last bits.
+// See model_internal.hpp. Newton's method on the characteristic polynomial from above (from
+// the Gershgorin bound: every root is real, so the iterates decrease monotonically to the
+// largest), with the pivots of T - x I as the Sturm sequence.
 double topTridiagonalEigenvalue(const Eigen::VectorXd& diag, const Eigen::VectorXd& sub) {
   const Eigen::Index n = diag.size();
   double x = -std::numeric_limits<double>::infinity();
@@ -28,29 +24,43 @@ double topTridiagonalEigenvalue(const Eigen::VectorXd& diag, const Eigen::Vector
   for (Eigen::Index i = 0; i < n; ++i) norm = std::max(norm, std::abs(diag[i]));
   for (Eigen::Index i = 0; i + 1 < n; ++i) norm = std::max(norm, std::abs(sub[i]));
   x += 1e-12 * norm + std::numeric_limits<double>::min();  // strictly above every root
-  for (int iter = 0; iter < 100; ++iter) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  // The largest root lies in (lo, hi]: hi the last iterate found above it, lo the last below.
+  double hi = x, lo = -std::numeric_limits<double>::infinity();
+  for (int iter = 0; iter < 200; ++iter) {
     // Pivots p_i of T - x I and their derivatives: p_i = d_i - x - e_{i-1}^2 / p_{i-1};
-    // f'/f = sum p_i' / p_i with p_i' = -1 + e_{i-1}^2 p_{i-1}' / p_{i-1}^2.
+    // f'/f = sum p_i' / p_i with p_i' = -1 + e_{i-1}^2 p_{i-1}' / p_{i-1}^2. All p_i < 0
+    // exactly when x is above every root (Sturm).
     double p = diag[0] - x, dp = -1.0;
-    if (!(p < 0.0)) return std::numeric_limits<double>::quiet_NaN();
+    bool below = !(p < 0.0);
     double ratio = dp / p;
-    for (Eigen::Index i = 1; i < n; ++i) {
+    for (Eigen::Index i = 1; i < n && !below; ++i) {
       const double e2 = sub[i - 1] * sub[i - 1];
       const double q = e2 / p;
       const double next_dp = -1.0 + q * dp / p;
       p = diag[i] - x - q;
       dp = next_dp;
-      if (!(p < 0.0)) return std::numeric_limits<double>::quiet_NaN();  // at or below a root: round-off
+      below = !(p < 0.0);
       ratio += dp / p;
     }
-    // f = prod p_i, f'/f = ratio > 0 above the roots; Newton steps down by 1 / ratio.
-    const double step = 1.0 / ratio;
-    if (!(step > 0.0)) return std::numeric_limits<double>::quiet_NaN();
-    x -= step;
-    if (step <= 4.0 * std::numeric_limits<double>::epsilon() * norm) return x;
+    if (below) {
+      lo = x;  // round-off stepped past the root (or landed on it): bisect back up
+    } else {
+      hi = x;
+      // f = prod p_i, f'/f = ratio > 0 above the roots; Newton steps down by 1 / ratio.
+      const double step = 1.0 / ratio;
+      if (!(step > 0.0)) return nan;
+      if (step <= 4.0 * std::numeric_limits<double>::epsilon() * norm) return x - step;
+      x -= step;
+      if (x > lo) continue;
+    }
+    if (hi - lo <= 1e-13 * norm) return hi;
+    x = 0.5 * (lo + hi);
   }
-  return std::numeric_limits<double>::quiet_NaN();
+  return nan;
 }
+
+namespace {
 
 // Top eigenvalue of M^-1/2 K M^-1/2 (springs linearised along their rest directions) over
 // the free nodes `nodes`, every other node held fixed (a principal submatrix), by Lanczos.
