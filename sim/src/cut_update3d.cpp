@@ -164,7 +164,7 @@ double topEigenvalue(const Model& m, const cutting::Positions& X, const std::vec
     q.normalize();
   }
   const int max_steps = std::max(1, std::min(options.lanczos_steps, static_cast<int>(n3)));
-  const bool reorthogonalise = n3 <= 3000;  // cheap near a small cut; not worth it over many nodes
+  const bool reorthogonalise = n3 <= options.lanczos_reorthogonalise_max;
   Eigen::MatrixXd Q(n3, max_steps);
   std::vector<double> alpha, beta, history;
   std::vector<std::uint8_t> exact;  // history[h] is the dense solver's value
