@@ -11,6 +11,55 @@
 #include "model_internal.hpp"
 
 namespace hysim::sim {
+
+// See model_internal.hpp. Newton's method on the characteristic polynomial from above (from
+// the Gershgorin bound: every root is real, so the iterates decrease monotonically to the
+// largest), with the pivots of T - x I as the Sturm sequence.
+double topTridiagonalEigenvalue(const Eigen::VectorXd& diag, const Eigen::VectorXd& sub) {
+  const Eigen::Index n = diag.size();
+  double x = -std::numeric_limits<double>::infinity();
+  for (Eigen::Index i = 0; i < n; ++i)
+    x = std::max(x, diag[i] + (i > 0 ? std::abs(sub[i - 1]) : 0.0) + (i + 1 < n ? std::abs(sub[i]) : 0.0));
+  double norm = 0.0;
+  for (Eigen::Index i = 0; i < n; ++i) norm = std::max(norm, std::abs(diag[i]));
+  for (Eigen::Index i = 0; i + 1 < n; ++i) norm = std::max(norm, std::abs(sub[i]));
+  x += 1e-12 * norm + std::numeric_limits<double>::min();  // strictly above every root
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  // The largest root lies in (lo, hi]: hi the last iterate found above it, lo the last below.
+  double hi = x, lo = -std::numeric_limits<double>::infinity();
+  for (int iter = 0; iter < 200; ++iter) {
+    // Pivots p_i of T - x I and their derivatives: p_i = d_i - x - e_{i-1}^2 / p_{i-1};
+    // f'/f = sum p_i' / p_i with p_i' = -1 + e_{i-1}^2 p_{i-1}' / p_{i-1}^2. All p_i < 0
+    // exactly when x is above every root (Sturm).
+    double p = diag[0] - x, dp = -1.0;
+    bool below = !(p < 0.0);
+    double ratio = dp / p;
+    for (Eigen::Index i = 1; i < n && !below; ++i) {
+      const double e2 = sub[i - 1] * sub[i - 1];
+      const double q = e2 / p;
+      const double next_dp = -1.0 + q * dp / p;
+      p = diag[i] - x - q;
+      dp = next_dp;
+      below = !(p < 0.0);
+      ratio += dp / p;
+    }
+    if (below) {
+      lo = x;  // round-off stepped past the root (or landed on it): bisect back up
+    } else {
+      hi = x;
+      // f = prod p_i, f'/f = ratio > 0 above the roots; Newton steps down by 1 / ratio.
+      const double step = 1.0 / ratio;
+      if (!(step > 0.0)) return nan;
+      if (step <= 4.0 * std::numeric_limits<double>::epsilon() * norm) return x - step;
+      x -= step;
+      if (x > lo) continue;
+    }
+    if (hi - lo <= 1e-13 * norm) return hi;
+    x = 0.5 * (lo + hi);
+  }
+  return nan;
+}
+
 namespace {
 
 // Top eigenvalue of M^-1/2 K M^-1/2 (springs linearised along their rest directions) over
@@ -115,9 +164,11 @@ double topEigenvalue(const Model& m, const cutting::Positions& X, const std::vec
     q.normalize();
   }
   const int max_steps = std::max(1, std::min(options.lanczos_steps, static_cast<int>(n3)));
-  const bool reorthogonalise = n3 <= 3000;  // cheap near a small cut; not worth it over many nodes
+  const bool reorthogonalise = n3 <= options.lanczos_reorthogonalise_max;
   Eigen::MatrixXd Q(n3, max_steps);
   std::vector<double> alpha, beta, history;
+  std::vector<std::uint8_t> exact;  // history[h] is the dense solver's value
+  bool theta_exact = true;
   Eigen::VectorXd z(n3);
   // Reorthogonalisation: Q^T z and Q (Q^T z), evaluated as the expression
   // z -= Q (Q^T z) evaluates them (into zeroed temporaries, then subtracted), in buffers
@@ -131,6 +182,23 @@ double topEigenvalue(const Model& m, const cutting::Positions& X, const std::vec
   Eigen::VectorXd ritz;
   Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(max_steps);
   Eigen::VectorXd tri_diag(max_steps), tri_sub(max_steps);
+  // The dense solver's top eigenvalue of the first `size` rows of T, scaled as the loop
+  // below scales it: the value the loop's step `size` would have had from it.
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig_exact(max_steps);
+  Eigen::VectorXd exact_diag(max_steps), exact_sub(max_steps);
+  auto exactTheta = [&](int size) {
+    if (size == 1) return alpha[0];
+    double scale = 0.0;
+    for (int i = 0; i < size; ++i) scale = std::max(scale, std::abs(alpha[i]));
+    for (int i = 0; i + 1 < size; ++i) scale = std::max(scale, std::abs(beta[i]));
+    if (scale == 0.0) scale = 1.0;
+    exact_diag.resize(size);
+    exact_sub.resize(size - 1);
+    for (int i = 0; i < size; ++i) exact_diag[i] = alpha[i] / scale;
+    for (int i = 0; i + 1 < size; ++i) exact_sub[i] = beta[i] / scale;
+    eig_exact.computeFromTridiagonal(exact_diag, exact_sub, Eigen::EigenvaluesOnly);
+    return eig_exact.eigenvalues()[size - 1] * scale;
+  };
   for (int j = 0; j < max_steps; ++j) {
     Q.col(j) = q;
     apply(q, z);
@@ -172,12 +240,17 @@ double topEigenvalue(const Model& m, const cutting::Positions& X, const std::vec
       }
       need_theta = !(b > 1e-14 * (2.0 * row_max * scale));  // 2x: room for round-off in the bound
     }
+    theta_exact = true;
     if (size == 1) {
       theta = alpha[0];
       ritz = Eigen::VectorXd::Ones(1);
     } else if (need_theta) {
-      eig.computeFromTridiagonal(tri_diag, tri_sub, Eigen::EigenvaluesOnly);
-      theta = eig.eigenvalues()[size - 1] * scale;
+      // Newton's value: it only decides the tests below, which ask the dense solver's value
+      // (as computed before) whenever it lies within 1e-9 of a threshold, so the decisions
+      // are the dense solver's (the values differ by round-off, ~1e-15).
+      theta = topTridiagonalEigenvalue(tri_diag, tri_sub) * scale;
+      theta_exact = false;
+      if (std::isnan(theta)) theta = exactTheta(size);
     } else {
       theta = std::numeric_limits<double>::quiet_NaN();
     }
@@ -186,8 +259,26 @@ double topEigenvalue(const Model& m, const cutting::Positions& X, const std::vec
     // theta has stopped growing over the last steps (it rises towards the top one; near the
     // top the spectrum is dense, so a small residual alone can stop below it).
     history.push_back(theta);
-    const bool settled = size > std::max(options.lanczos_min_steps, 5) &&
-                         theta - history[history.size() - 6] <= options.lanczos_tolerance * std::abs(theta);
+    exact.push_back(theta_exact ? 1 : 0);
+    auto makeExact = [&](size_t h) {
+      if (!exact[h]) {
+        history[h] = exactTheta(static_cast<int>(h) + 1);
+        exact[h] = 1;
+      }
+    };
+    bool settled = false;
+    if (size > std::max(options.lanczos_min_steps, 5)) {
+      const size_t back = history.size() - 6, now = history.size() - 1;
+      const double margin = 1e-9 * std::abs(history[now]);
+      const double gap = options.lanczos_tolerance * std::abs(history[now]) - (history[now] - history[back]);
+      if (!(std::abs(gap) > margin)) {  // close (or NaN): as the dense solver's values decide
+        makeExact(back);
+        makeExact(now);
+      }
+      settled = history[now] - history[back] <= options.lanczos_tolerance * std::abs(history[now]);
+    }
+    if (!(b > 2e-14 * std::abs(history.back()))) makeExact(history.size() - 1);
+    theta = history.back();
     const bool last = b <= 1e-14 * std::abs(theta) || j + 1 == max_steps;
     if (settled || last) {
       if (size > 1) {

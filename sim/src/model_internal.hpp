@@ -12,6 +12,12 @@ namespace hysim::sim {
 // Model::step_springs from the spring arrays, fixed flags and num_nodes (O(#S + #N)).
 void buildStepSprings(Model& model);
 
+// The largest eigenvalue of the symmetric tridiagonal matrix with diagonal `diag` and
+// subdiagonal `sub` (size diag.size() - 1), to a few units in the last place of the matrix's
+// largest entry; NaN when it does not settle (the caller then asks a dense solver). Cheaper
+// than a full eigenvalue solve; its value can differ from one in those last bits.
+double topTridiagonalEigenvalue(const Eigen::VectorXd& diag, const Eigen::VectorXd& sub);
+
 // The ten monomials up to second order of a point (1, x, y, z, x², y², z², xy, yz, zx):
 // the mass moments the tissue updates after a cut keep.
 using Row10 = Eigen::Matrix<double, 10, 1>;

@@ -105,6 +105,13 @@ struct CutUpdate3DOptions {
   // steps instead of 21-48 (bench/bench_model_update, HYSIM_LANCZOS_MIN_STEPS).
   int lanczos_min_steps = 10;
   double lanczos_tolerance = 1e-3;  // relative residual of the top Ritz pair, and its growth over 5 steps
+  // Full reorthogonalisation of each Lanczos vector against the previous ones when 3 x the
+  // estimate's free nodes is at most this. 3000 before (every shaving pass's estimate): 0,
+  // none, takes the same number of steps on the 4 planes through the 20k-tet uterus and the
+  // 57 recorded shaving passes, with omega_max equal to 7 digits and the same substeps
+  // (bench/bench_model_update), and the same default-scene hash; it saves two
+  // (3 #nodes x step) matrix-vector products per step.
+  int lanczos_reorthogonalise_max = 0;
   // Updates in a row whose omega_max may be the previous one held as a bound after its
   // mode was near the cut (Model::stability_held); 0 = estimate over all nodes instead.
   int max_held_estimates = 4;
