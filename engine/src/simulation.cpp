@@ -230,7 +230,7 @@ Status Simulation::rebuildGeometry(PassRecord* timing, const std::vector<std::ui
 }
 
 Status Simulation::buildGeometry(const cutting::TetMesh& mesh, const sim::NodeVectors& x, PassRecord* timing,
-                                 const std::vector<std::uint8_t>* boundary) {
+                                 const std::vector<std::uint8_t>* boundary, const std::vector<int>* renumber) {
   PassTimer timer;
 
   // Surface for contact and rendering: boundary faces, compacted vertex numbering.
@@ -273,7 +273,7 @@ Status Simulation::buildGeometry(const cutting::TetMesh& mesh, const sim::NodeVe
   timer.lap(timing ? &timing->surface_ms : nullptr);
   // The boundary's hierarchy, with boxes grown by half a millimetre: while the tissue near
   // the loop moves less than that, a step only moves the vertices (see collision.hpp).
-  if (Status st = collision_.build(surface_faces_, x, 0.5); !st.ok()) return st;
+  if (Status st = collision_.build(surface_faces_, x, 0.5, &mesh.X, renumber); !st.ok()) return st;
   timer.lap(timing ? &timing->collision_ms : nullptr);
   return Status::Ok();
 }
@@ -771,9 +771,15 @@ void Simulation::finishPass() {
   // positions and on-cut flags only, what this thread does until the join (face neighbours,
   // serosa, chips, the model update) on none of them, and each writes its own members, so
   // the result is the same as one after the other.
+  // The old mesh's nodes in the kept numbering (the collision hierarchy's and the serosa's).
+  std::vector<int> old_to_kept(change.node_old_to_new.size(), -1);
+  for (size_t i = 0; i < change.node_old_to_new.size(); ++i) {
+    const int j = change.node_old_to_new[i];
+    if (j >= 0 && j < n) old_to_kept[i] = new_index[j];
+  }
   Status geometry;
   std::thread geometry_thread([&] {
-    geometry = buildGeometry(rest_mesh, x_kept, &rec, kept_boundary.empty() ? nullptr : &kept_boundary);
+    geometry = buildGeometry(rest_mesh, x_kept, &rec, kept_boundary.empty() ? nullptr : &kept_boundary, &old_to_kept);
   });
   // The kept mesh's face neighbours, for the next pass (a kept tet's neighbours are kept).
   std::vector<int> kept_next;
@@ -792,11 +798,6 @@ void Simulation::finishPass() {
       }
   }
   // The serosa follows its nodes into the new numbering.
-  std::vector<int> old_to_kept(change.node_old_to_new.size(), -1);
-  for (size_t i = 0; i < change.node_old_to_new.size(); ++i) {
-    const int j = change.node_old_to_new[i];
-    if (j >= 0 && j < n) old_to_kept[i] = new_index[j];
-  }
   outer_wall_.remapNodes(old_to_kept);
   timer.lap(&rec.components_ms);
   std::vector<ChipShape> chip_shapes;

@@ -151,9 +151,12 @@ class Simulation {
   // boundary faces, render surface and FCL hierarchy. It writes only those members
   // (surface_*, collision_) and reads on_cut_ and scene_, so a pass runs it on a second
   // thread beside the model update. Times surface_ms, collision_ms. (The tet locator is
-  // rebuildGeometry's, or the pass's background thread's.)
+  // rebuildGeometry's, or the pass's background thread's.) `renumber` (optional, #N of the
+  // mesh the hierarchy was last built for): the node each of its nodes became in `mesh`, or
+  // -1; with it, the hierarchy's chunks whose faces did not change are kept (see
+  // TissueCollision::build).
   Status buildGeometry(const cutting::TetMesh& mesh, const sim::NodeVectors& x, PassRecord* timing,
-                       const std::vector<std::uint8_t>* boundary);
+                       const std::vector<std::uint8_t>* boundary, const std::vector<int>* renumber = nullptr);
   // rebuildGeometry's second part, once mesh_, model_ and state_ are the new ones: contact
   // nodes and forces, collision flags, chips' cavity, topology version.
   void finishGeometry(PassRecord* timing);
