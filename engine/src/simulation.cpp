@@ -168,10 +168,24 @@ Status Simulation::setTopology(cutting::TetMesh rest_mesh, const sim::NodeVector
   model_ = std::move(model.value());
   resetState(x, v);
   if (!matchFaces(mesh_, face_next_)) face_next_.clear();
+  anchorPieces();
   timer.lap(timing ? &timing->model_ms : nullptr);
   tet_quality_.resize(static_cast<size_t>(mesh_.numTets()));
   for (int t = 0; t < mesh_.numTets(); ++t) tet_quality_[t] = tetQuality(mesh_, t);
   return rebuildGeometry(timing);
+}
+
+int Simulation::anchorPieces() {
+  anchor_distance_.clear();
+  pieces_anchored_ = false;
+  if (face_next_.size() != 4 * static_cast<size_t>(mesh_.numTets()) ||
+      anchored_.size() != static_cast<size_t>(mesh_.numNodes())) {
+    return -1;
+  }
+  anchor_distance_ = anchorDistance(mesh_, face_next_, anchored_);
+  pieces_anchored_ = std::find(anchor_distance_.begin(), anchor_distance_.end(), std::numeric_limits<int>::max()) ==
+                     anchor_distance_.end();
+  return tetPieces(mesh_, face_next_, anchored_).count;
 }
 
 double Simulation::tetQuality(const cutting::TetMesh& mesh, int t) {
@@ -689,10 +703,24 @@ void Simulation::finishPass() {
   // Chips: pieces connected to no anchored node are removed (their volume is resected).
   // Face neighbours of the cut mesh: from the previous mesh's, rematching only the faces
   // near the cut (all faces when that cannot be done).
+  // When every piece before the cut was anchored and stays so, only the tets near the cut
+  // are searched (freePiecesAfterCut): the free pieces are the same, in the same order, and
+  // the number of pieces (rec.components) is counted after the pass, beside the locator.
   std::vector<int> face_next;
   Pieces comps;
-  if (updateFaces(mesh_, face_next_, after, change.node_old_to_new, change.element_old_to_new, face_next) ||
-      matchFaces(after, face_next)) {
+  FaceChange face_change;
+  bool near_cut = false;
+  if (updateFaces(mesh_, face_next_, after, change.node_old_to_new, change.element_old_to_new, face_next,
+                  &face_change)) {
+    near_cut = pieces_anchored_ && anchor_distance_.size() == static_cast<size_t>(mesh_.numTets()) &&
+               anchored_.size() == change.node_old_to_new.size();
+    for (size_t i = 0; i < change.node_old_to_new.size() && near_cut; ++i) {
+      const int j = change.node_old_to_new[i];
+      near_cut = !anchored_[i] || (j >= 0 && j < n && anchored_after[j]);
+    }
+    comps = near_cut ? freePiecesAfterCut(after, face_next, anchored_after, face_change, anchor_distance_)
+                     : tetPieces(after, face_next, anchored_after);
+  } else if (matchFaces(after, face_next)) {
     comps = tetPieces(after, face_next, anchored_after);
   } else {  // not reached for a valid mesh
     std::vector<int> anchored;
@@ -720,7 +748,7 @@ void Simulation::finishPass() {
     if (after.material[t] == myoma_label) rec.removed_myoma_mm3 += vol;
   }
   for (int c = 0; c < comps.count; ++c) rec.chips += comps.free[c] ? 1 : 0;
-  rec.components = comps.count;
+  rec.components = comps.count;  // near_cut: replaced after the pass
   // The kept nodes, renumbered in their order (so the model's arrays compact in place).
   std::vector<std::int32_t> new_index(n, -1);
   for (int t : keep_tets)
@@ -871,11 +899,17 @@ void Simulation::finishPass() {
   // until the next pass, which waits first) and its own copy of the positions at the cut,
   // so it is the same locator as one built here. Its time goes to this pass's locator_ms
   // (passes_ grows only in finishPass, after the wait).
+  // The same thread finds the new mesh's distances to the anchors for the next pass and, when
+  // this pass searched near its cut only, counts the pieces (the kept mesh's, all anchored,
+  // and the chips).
   double* locator_ms = &passes_.back().locator_ms;
-  locator_thread_ = std::thread([this, x = std::move(x_kept), locator_ms] {
+  int* components = near_cut ? &passes_.back().components : nullptr;
+  locator_thread_ = std::thread([this, x = std::move(x_kept), locator_ms, components, chips = rec.chips] {
     PassTimer build_timer;
     locator_.build(mesh_, x);
     buildNearest(mesh_, x);
+    const int kept_pieces = anchorPieces();
+    if (components != nullptr) *components = kept_pieces < 0 ? -1 : kept_pieces + chips;
     build_timer.lap(locator_ms);
   });
 }

@@ -221,6 +221,9 @@ class Simulation {
   // that reads locator_ (the buried test, the next pass, rebuildGeometry) waits first.
   mutable std::thread locator_thread_;
   void waitLocator() const;
+  // anchor_distance_ and pieces_anchored_ of mesh_, face_next_ and anchored_ (cleared and
+  // false when face_next_ is unknown); returns the number of pieces of mesh_ (-1: unknown).
+  int anchorPieces();
   Eigen::Matrix<double, Eigen::Dynamic, 3> wire_, previous_wire_;
   Sweep sweep_;
   std::vector<Eigen::Vector3d> rest_rows_;  // the open pass's kept rows, rest shape (mapSweepRows)
@@ -239,6 +242,11 @@ class Simulation {
   std::vector<std::uint8_t> anchored_;  // #N: rest position in an anchor region (fixed)
   std::vector<double> tet_quality_;     // #T: q* of each element (rest shape), for q_min
   std::vector<int> face_next_;          // 4 #T: matchFaces' next of mesh_ (empty: unknown)
+  // #T: anchorDistance of mesh_ (empty: unknown), and whether every piece of mesh_ has an
+  // anchored node (then a pass searches for free pieces near its cut only, see finishPass).
+  // After a pass both are computed on the locator's background thread.
+  std::vector<int> anchor_distance_;
+  bool pieces_anchored_ = false;
   double initial_myoma_mm3_ = 0.0;
   double electrode_active_s_ = 0.0;
   double path_length_mm_ = 0.0;
