@@ -206,6 +206,15 @@ void BM_FacesPieces(benchmark::State& state) {
   }
   state.counters["chips"] = chips;
   state.counters["passes"] = static_cast<double>(passes.size());
+  int identity = 0;
+  for (const CutPass& p : passes) {
+    bool same = true;
+    for (size_t i = 0; i < p.change.node_old_to_new.size() && same; ++i) same = p.change.node_old_to_new[i] == static_cast<int>(i);
+    for (size_t t = 0; t < p.change.element_old_to_new.size() && same; ++t)
+      same = p.change.element_old_to_new[t] < 0 || p.change.element_old_to_new[t] == static_cast<int>(t);
+    identity += same;
+  }
+  state.counters["identity_maps"] = identity;
 }
 BENCHMARK(BM_FacesPieces)->Unit(benchmark::kMillisecond);
 

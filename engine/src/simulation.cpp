@@ -796,8 +796,8 @@ void Simulation::finishPass() {
   }
   // Meanwhile a second thread builds the kept mesh's boundary, render surface and FCL
   // hierarchy (buildGeometry), as soon as its inputs exist: they depend on the kept mesh,
-  // positions and on-cut flags only, what this thread does until the join (face neighbours,
-  // serosa, chips, the model update) on none of them, and each writes its own members, so
+  // positions and on-cut flags only, what this thread does until the join (serosa, chips,
+  // the model update) on none of them, and each writes its own members, so
   // the result is the same as one after the other.
   // The old mesh's nodes in the kept numbering (the collision hierarchy's and the serosa's).
   std::vector<int> old_to_kept(change.node_old_to_new.size(), -1);
@@ -805,13 +805,17 @@ void Simulation::finishPass() {
     const int j = change.node_old_to_new[i];
     if (j >= 0 && j < n) old_to_kept[i] = new_index[j];
   }
+  // The same thread then finds the kept mesh's face neighbours, for the next pass (a kept
+  // tet's neighbours are kept): from face_next and keep_tets, which this thread only reads.
   Status geometry;
+  std::vector<int> kept_next;
   std::thread geometry_thread([&] {
     geometry = buildGeometry(rest_mesh, x_kept, &rec, kept_boundary.empty() ? nullptr : &kept_boundary, &old_to_kept);
-  });
-  // The kept mesh's face neighbours, for the next pass (a kept tet's neighbours are kept).
-  std::vector<int> kept_next;
-  if (!face_next.empty()) {
+    if (face_next.empty()) return;
+    if (keep_tets.size() == static_cast<size_t>(after.numTets())) {  // no piece removed
+      kept_next = face_next;
+      return;
+    }
     std::vector<int> kept_of(static_cast<size_t>(after.numTets()), -1);
     for (size_t k = 0; k < keep_tets.size(); ++k) kept_of[keep_tets[k]] = static_cast<int>(k);
     kept_next.resize(4 * keep_tets.size());
@@ -824,7 +828,7 @@ void Simulation::finishPass() {
         }
         kept_next[4 * k + f] = p < 0 ? -1 : 4 * kept_of[p / 4] + p % 4;
       }
-  }
+  });
   // The serosa follows its nodes into the new numbering.
   outer_wall_.remapNodes(old_to_kept);
   timer.lap(&rec.components_ms);

@@ -39,7 +39,10 @@ struct PassRecord {
   // then waited for them (what they add to cut_ms), and other_ms is computed with
   // geometry_wait_ms in place of those two. The tet locator (locator_ms) is built on a
   // background thread after the pass has ended, beside the following steps, and is not part
-  // of cut_ms (at the start of a run, setTopology builds it in place).
+  // of cut_ms (at the start of a run, setTopology builds it in place); the same thread finds
+  // the new mesh's distances to the anchors (for the next pass's piece search) and, when the
+  // pass searched for free pieces near its cut only, counts `components`: locator_ms includes
+  // both.
   double map_ms = 0.0, cut3d_ms = 0.0, remap_ms = 0.0, components_ms = 0.0, model_ms = 0.0, surface_ms = 0.0,
          collision_ms = 0.0, locator_ms = 0.0, chips_ms = 0.0, stats_ms = 0.0, other_ms = 0.0,
          geometry_wait_ms = 0.0;
@@ -48,7 +51,7 @@ struct PassRecord {
   double removed_myoma_mm3 = 0.0;
   double sweep_area_mm2 = 0.0;  // area of the cut surface (the loop's sweep)
   int crossed_edges = 0, snapped_nodes = 0, split_edges = 0, duplicated_nodes = 0, cut_faces = 0;
-  int components = 0;
+  int components = 0;        // pieces of the cut mesh (chips included); passes() waits for it
   int substeps = 0;          // of the rebuilt model
   double added_mass_g = 0.0; // mass scaling needed to keep substeps within the cap (since the start)
   int stability_nodes = 0;   // free nodes of the model update's frequency estimate
