@@ -756,31 +756,6 @@ void Simulation::finishPass() {
   int kept_nodes = 0;
   for (int i = 0; i < n; ++i)
     if (new_index[i] == 0) new_index[i] = kept_nodes++;
-  cutting::TetMesh rest_mesh;
-  rest_mesh.X.resize(kept_nodes, 3);
-  sim::NodeVectors x_kept(kept_nodes, 3), v_kept(kept_nodes, 3);
-  std::vector<std::uint8_t> anchored_kept(static_cast<size_t>(kept_nodes), 0);
-  for (int i = 0; i < n; ++i) {
-    if (new_index[i] < 0) continue;
-    rest_mesh.X.row(new_index[i]) = rest.row(i);
-    x_kept.row(new_index[i]) = xnew.row(i);
-    v_kept.row(new_index[i]) = v.row(i);
-    anchored_kept[new_index[i]] = anchored_after[i];
-  }
-  rest_mesh.T.resize(static_cast<Eigen::Index>(keep_tets.size()), 4);
-  rest_mesh.material.resize(static_cast<Eigen::Index>(keep_tets.size()));
-  for (size_t k = 0; k < keep_tets.size(); ++k) {
-    for (int c = 0; c < 4; ++c) rest_mesh.T(static_cast<Eigen::Index>(k), c) = new_index[after.T(keep_tets[k], c)];
-    rest_mesh.material[static_cast<Eigen::Index>(k)] = after.material[keep_tets[k]];
-  }
-  // Its boundary: the kept tets' faces that no other tet shares (a kept tet's neighbours
-  // are in its component, so kept too), in the order cutting::boundaryFaces gives.
-  std::vector<std::uint8_t> kept_boundary;
-  if (!face_next.empty()) {
-    kept_boundary.resize(4 * keep_tets.size());
-    for (size_t k = 0; k < keep_tets.size(); ++k)
-      for (int f = 0; f < 4; ++f) kept_boundary[4 * k + f] = face_next[4 * static_cast<size_t>(keep_tets[k]) + f] < 0;
-  }
   // Nodes on a cut surface, this pass's and earlier ones', in the new numbering.
   std::vector<std::uint8_t> on_cut(n, 0);
   for (int i = 0; i < static_cast<int>(change.node_old_to_new.size()); ++i) {
@@ -794,22 +769,50 @@ void Simulation::finishPass() {
   for (int i = 0; i < n; ++i) {
     if (new_index[i] >= 0) on_cut_[new_index[i]] = on_cut[i];
   }
-  // Meanwhile a second thread builds the kept mesh's boundary, render surface and FCL
-  // hierarchy (buildGeometry), as soon as its inputs exist: they depend on the kept mesh,
-  // positions and on-cut flags only, what this thread does until the join (serosa, chips,
-  // the model update) on none of them, and each writes its own members, so
-  // the result is the same as one after the other.
+  // Meanwhile a second thread compacts the kept mesh and builds its boundary, render surface
+  // and FCL hierarchy (buildGeometry), as soon as their inputs exist: they depend on the cut
+  // mesh, positions, pieces and on-cut flags only, which this thread only reads until the join
+  // (serosa, chips, the model update), none of which depends on them, and each writes its own
+  // members, so the result is the same as one after the other.
   // The old mesh's nodes in the kept numbering (the collision hierarchy's and the serosa's).
   std::vector<int> old_to_kept(change.node_old_to_new.size(), -1);
   for (size_t i = 0; i < change.node_old_to_new.size(); ++i) {
     const int j = change.node_old_to_new[i];
     if (j >= 0 && j < n) old_to_kept[i] = new_index[j];
   }
-  // The same thread then finds the kept mesh's face neighbours, for the next pass (a kept
-  // tet's neighbours are kept): from face_next and keep_tets, which this thread only reads.
+  // The kept mesh (rest positions, tets), its positions, velocities and anchors, and its
+  // boundary: the kept tets' faces that no other tet shares (a kept tet's neighbours are in
+  // its component, so kept too), in the order cutting::boundaryFaces gives. Made on the
+  // geometry thread (nothing on this one reads them before the join), which then also finds
+  // the kept mesh's face neighbours, for the next pass (a kept tet's neighbours are kept).
+  cutting::TetMesh rest_mesh;
+  sim::NodeVectors x_kept, v_kept;
+  std::vector<std::uint8_t> anchored_kept, kept_boundary;
   Status geometry;
   std::vector<int> kept_next;
   std::thread geometry_thread([&] {
+    rest_mesh.X.resize(kept_nodes, 3);
+    x_kept.resize(kept_nodes, 3);
+    v_kept.resize(kept_nodes, 3);
+    anchored_kept.assign(static_cast<size_t>(kept_nodes), 0);
+    for (int i = 0; i < n; ++i) {
+      if (new_index[i] < 0) continue;
+      rest_mesh.X.row(new_index[i]) = rest.row(i);
+      x_kept.row(new_index[i]) = xnew.row(i);
+      v_kept.row(new_index[i]) = v.row(i);
+      anchored_kept[new_index[i]] = anchored_after[i];
+    }
+    rest_mesh.T.resize(static_cast<Eigen::Index>(keep_tets.size()), 4);
+    rest_mesh.material.resize(static_cast<Eigen::Index>(keep_tets.size()));
+    for (size_t k = 0; k < keep_tets.size(); ++k) {
+      for (int c = 0; c < 4; ++c) rest_mesh.T(static_cast<Eigen::Index>(k), c) = new_index[after.T(keep_tets[k], c)];
+      rest_mesh.material[static_cast<Eigen::Index>(k)] = after.material[keep_tets[k]];
+    }
+    if (!face_next.empty()) {
+      kept_boundary.resize(4 * keep_tets.size());
+      for (size_t k = 0; k < keep_tets.size(); ++k)
+        for (int f = 0; f < 4; ++f) kept_boundary[4 * k + f] = face_next[4 * static_cast<size_t>(keep_tets[k]) + f] < 0;
+    }
     geometry = buildGeometry(rest_mesh, x_kept, &rec, kept_boundary.empty() ? nullptr : &kept_boundary, &old_to_kept);
     if (face_next.empty()) return;
     if (keep_tets.size() == static_cast<size_t>(after.numTets())) {  // no piece removed
