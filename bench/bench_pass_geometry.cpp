@@ -4,6 +4,7 @@
 // deformed ones.
 #include <benchmark/benchmark.h>
 
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <string>
@@ -113,16 +114,17 @@ void BM_Locate(benchmark::State& state) {
 }
 BENCHMARK(BM_Locate)->Arg(0)->Arg(5)->Arg(10)->Unit(benchmark::kMillisecond);
 
-// updateFaces + tetPieces after each dumped pass's hybrid cut (as Simulation::finishPass).
-void BM_FacesPieces(benchmark::State& state) {
-  struct Pass {
-    cutting::TetMesh before, after;
-    cutting::TopologyChange change;
-    std::vector<int> next_before;
-    std::vector<std::uint8_t> anchored;
-  };
-  static std::vector<Pass> passes = [] {
-    std::vector<Pass> out;
+// Each dumped pass's hybrid cut: the mesh before and after, the change, face neighbours
+// before, anchors after (the default scene's: outside the 25 x 20 x 33 mm ellipsoid).
+struct CutPass {
+  cutting::TetMesh before, after;
+  cutting::TopologyChange change;
+  std::vector<int> next_before;
+  std::vector<std::uint8_t> anchored;
+};
+const std::vector<CutPass>& cutPasses() {
+  static std::vector<CutPass> passes = [] {
+    std::vector<CutPass> out;
     cutting::TetMesh mesh;
     cutting::TriMesh surface;
     for (int i = 1; bench::readDumpedPass(i, mesh, surface); ++i) {
@@ -132,7 +134,7 @@ void BM_FacesPieces(benchmark::State& state) {
       o.method = cutting::CutMethod::Hybrid;
       auto r = cutting::cut3d(mesh, *s, o);
       if (!r.ok()) break;
-      Pass p;
+      CutPass p;
       p.before = std::move(mesh);
       p.after = std::move(r->mesh);
       p.change = std::move(r->change);
@@ -146,12 +148,54 @@ void BM_FacesPieces(benchmark::State& state) {
     }
     return out;
   }();
+  return passes;
+}
+
+// The collision hierarchy of each pass's cut mesh, built after the one of the mesh before:
+// keeping the chunks the cut did not change (range(0) = 1) or from scratch (0). Manual time:
+// the second build only.
+void BM_CollisionAfterCut(benchmark::State& state) {
+  const std::vector<CutPass>& passes = cutPasses();
+  if (passes.empty()) return state.SkipWithError("no HYSIM_REPLAY_DIR");
+  const bool keep = state.range(0) != 0;
+  std::vector<cutting::Tris> before, after;
+  std::vector<std::vector<int>> renumber;
+  for (const CutPass& p : passes) {
+    before.push_back(cutting::boundaryFaces(p.before));
+    after.push_back(cutting::boundaryFaces(p.after));
+    renumber.emplace_back(p.change.node_old_to_new.begin(), p.change.node_old_to_new.end());
+  }
+  long built = 0, kept = 0;
+  for (auto _ : state) {
+    double seconds = 0.0;
+    built = kept = 0;
+    for (size_t i = 0; i < passes.size(); ++i) {
+      engine::TissueCollision c;
+      if (!c.build(before[i], passes[i].before.X, 0.5, &passes[i].before.X).ok()) return state.SkipWithError("build");
+      const long b0 = c.numChunksBuilt(), k0 = c.numChunksKept();
+      const auto t0 = std::chrono::steady_clock::now();
+      const bool ok = c.build(after[i], passes[i].after.X, 0.5, &passes[i].after.X, keep ? &renumber[i] : nullptr).ok();
+      seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      if (!ok) return state.SkipWithError("build after");
+      built += c.numChunksBuilt() - b0;
+      kept += c.numChunksKept() - k0;
+    }
+    state.SetIterationTime(seconds);
+  }
+  state.counters["chunks_built"] = static_cast<double>(built) / static_cast<double>(passes.size());
+  state.counters["chunks_kept"] = static_cast<double>(kept) / static_cast<double>(passes.size());
+}
+BENCHMARK(BM_CollisionAfterCut)->Arg(0)->Arg(1)->UseManualTime()->Unit(benchmark::kMillisecond);
+
+// updateFaces + tetPieces after each dumped pass's hybrid cut (as Simulation::finishPass).
+void BM_FacesPieces(benchmark::State& state) {
+  const std::vector<CutPass>& passes = cutPasses();
   if (passes.empty()) return state.SkipWithError("no HYSIM_REPLAY_DIR");
   std::vector<int> next;
   int chips = 0;
   for (auto _ : state) {
     chips = 0;
-    for (const Pass& p : passes) {
+    for (const CutPass& p : passes) {
       if (!engine::updateFaces(p.before, p.next_before, p.after, p.change.node_old_to_new,
                                p.change.element_old_to_new, next)) {
         return state.SkipWithError("updateFaces failed");
@@ -162,6 +206,15 @@ void BM_FacesPieces(benchmark::State& state) {
   }
   state.counters["chips"] = chips;
   state.counters["passes"] = static_cast<double>(passes.size());
+  int identity = 0;
+  for (const CutPass& p : passes) {
+    bool same = true;
+    for (size_t i = 0; i < p.change.node_old_to_new.size() && same; ++i) same = p.change.node_old_to_new[i] == static_cast<int>(i);
+    for (size_t t = 0; t < p.change.element_old_to_new.size() && same; ++t)
+      same = p.change.element_old_to_new[t] < 0 || p.change.element_old_to_new[t] == static_cast<int>(t);
+    identity += same;
+  }
+  state.counters["identity_maps"] = identity;
 }
 BENCHMARK(BM_FacesPieces)->Unit(benchmark::kMillisecond);
 

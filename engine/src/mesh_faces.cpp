@@ -58,7 +58,7 @@ bool matchFaces(const cutting::TetMesh& mesh, std::vector<int>& next) {
 
 bool updateFaces(const cutting::TetMesh& before, const std::vector<int>& next_before, const cutting::TetMesh& after,
                  const std::vector<std::int32_t>& node_old_to_new, const std::vector<std::int32_t>& element_old_to_new,
-                 std::vector<int>& next) {
+                 std::vector<int>& next, FaceChange* change) {
   const int T0 = before.numTets(), T1 = after.numTets(), N0 = before.numNodes(), N1 = after.numNodes();
   if (next_before.size() != 4 * static_cast<size_t>(T0) || element_old_to_new.size() != static_cast<size_t>(T0) ||
       node_old_to_new.size() != static_cast<size_t>(N0)) {
@@ -160,6 +160,12 @@ bool updateFaces(const cutting::TetMesh& before, const std::vector<int>& next_be
     i = j;
   }
   next = std::move(out);
+  if (change != nullptr) {
+    change->near_cut.clear();
+    for (int s : open)  // ascending slots: ascending tets
+      if (change->near_cut.empty() || change->near_cut.back() != s / 4) change->near_cut.push_back(s / 4);
+    change->old_of = std::move(old_of);
+  }
   return true;
 }
 
@@ -194,6 +200,102 @@ Pieces tetPieces(const cutting::TetMesh& mesh, const std::vector<int>& next, con
   for (int t = 0; t < M; ++t)
     for (int k = 0; k < 4; ++k)
       if (anchored[mesh.T(t, k)]) c.free[c.label[t]] = 0;
+  return c;
+}
+
+std::vector<int> anchorDistance(const cutting::TetMesh& mesh, const std::vector<int>& next,
+                                const std::vector<std::uint8_t>& anchored) {
+  const int M = mesh.numTets();
+  std::vector<int> dist(static_cast<size_t>(M), std::numeric_limits<int>::max());
+  std::vector<int> queue;
+  queue.reserve(static_cast<size_t>(M));
+  for (int t = 0; t < M; ++t)
+    for (int k = 0; k < 4; ++k)
+      if (anchored[mesh.T(t, k)]) {
+        dist[t] = 0;
+        queue.push_back(t);
+        break;
+      }
+  const size_t slots = std::min(next.size(), 4 * static_cast<size_t>(M));
+  for (size_t head = 0; head < queue.size(); ++head) {
+    const int u = queue[head];
+    for (int f = 0; f < 4; ++f) {
+      const size_t s = 4 * static_cast<size_t>(u) + f;
+      if (s >= slots) break;
+      const int p = next[s];
+      if (p < 0 || p / 4 >= M || dist[p / 4] != std::numeric_limits<int>::max()) continue;
+      dist[p / 4] = dist[u] + 1;
+      queue.push_back(p / 4);
+    }
+  }
+  return dist;
+}
+
+Pieces freePiecesAfterCut(const cutting::TetMesh& after, const std::vector<int>& next,
+                          const std::vector<std::uint8_t>& anchored, const FaceChange& change,
+                          const std::vector<int>& distance_before) {
+  const int M = after.numTets();
+  const size_t slots = std::min(next.size(), 4 * static_cast<size_t>(M));
+  auto distance = [&](int t) {
+    const int o = t < static_cast<int>(change.old_of.size()) ? change.old_of[t] : -1;
+    return o >= 0 && o < static_cast<int>(distance_before.size()) ? distance_before[o] : std::numeric_limits<int>::max();
+  };
+  // label: -1 unseen, else the search that reached the tet.
+  std::vector<int> label(static_cast<size_t>(M), -1);
+  std::vector<std::uint8_t> free_search;  // per search
+  std::vector<int> stack;
+  stack.reserve(256);
+  for (int seed : change.near_cut) {
+    if (seed < 0 || seed >= M || label[seed] >= 0) continue;
+    const int id = static_cast<int>(free_search.size());
+    bool anchored_found = false;
+    label[seed] = id;
+    stack.assign(1, seed);
+    while (!stack.empty() && !anchored_found) {
+      const int u = stack.back();
+      stack.pop_back();
+      for (int k = 0; k < 4 && !anchored_found; ++k) anchored_found = anchored[after.T(u, k)] != 0;
+      if (anchored_found) break;
+      // Unseen neighbours, the nearest to the anchors pushed last (popped first).
+      int nb[4], nd[4], count = 0;
+      for (int f = 0; f < 4; ++f) {
+        const size_t s = 4 * static_cast<size_t>(u) + f;
+        if (s >= slots) break;
+        const int p = next[s];
+        if (p < 0 || p / 4 >= M) continue;
+        const int w = p / 4;
+        if (label[w] == id) continue;
+        if (label[w] >= 0) {  // an earlier search's tet: that search met the anchors
+          anchored_found = true;
+          break;
+        }
+        label[w] = id;
+        int j = count++;
+        const int d = distance(w);
+        for (; j > 0 && nd[j - 1] < d; --j) {  // descending distance
+          nb[j] = nb[j - 1];
+          nd[j] = nd[j - 1];
+        }
+        nb[j] = w;
+        nd[j] = d;
+      }
+      for (int j = 0; j < count; ++j) stack.push_back(nb[j]);
+    }
+    free_search.push_back(anchored_found ? 0 : 1);
+  }
+  // Free searches to pieces 1, 2, ... in the order of their first tet; the rest to piece 0.
+  Pieces c;
+  std::vector<int> piece_of(free_search.size(), 0);
+  c.label.assign(static_cast<size_t>(M), 0);
+  c.count = 1;
+  for (int t = 0; t < M; ++t) {
+    const int id = label[t];
+    if (id < 0 || !free_search[id]) continue;
+    if (piece_of[id] == 0) piece_of[id] = c.count++;
+    c.label[t] = piece_of[id];
+  }
+  c.free.assign(static_cast<size_t>(c.count), 1);
+  c.free[0] = 0;
   return c;
 }
 

@@ -168,10 +168,24 @@ Status Simulation::setTopology(cutting::TetMesh rest_mesh, const sim::NodeVector
   model_ = std::move(model.value());
   resetState(x, v);
   if (!matchFaces(mesh_, face_next_)) face_next_.clear();
+  anchorPieces();
   timer.lap(timing ? &timing->model_ms : nullptr);
   tet_quality_.resize(static_cast<size_t>(mesh_.numTets()));
   for (int t = 0; t < mesh_.numTets(); ++t) tet_quality_[t] = tetQuality(mesh_, t);
   return rebuildGeometry(timing);
+}
+
+int Simulation::anchorPieces() {
+  anchor_distance_.clear();
+  pieces_anchored_ = false;
+  if (face_next_.size() != 4 * static_cast<size_t>(mesh_.numTets()) ||
+      anchored_.size() != static_cast<size_t>(mesh_.numNodes())) {
+    return -1;
+  }
+  anchor_distance_ = anchorDistance(mesh_, face_next_, anchored_);
+  pieces_anchored_ = std::find(anchor_distance_.begin(), anchor_distance_.end(), std::numeric_limits<int>::max()) ==
+                     anchor_distance_.end();
+  return tetPieces(mesh_, face_next_, anchored_).count;
 }
 
 double Simulation::tetQuality(const cutting::TetMesh& mesh, int t) {
@@ -233,7 +247,7 @@ Status Simulation::rebuildGeometry(PassRecord* timing, const std::vector<std::ui
 }
 
 Status Simulation::buildGeometry(const cutting::TetMesh& mesh, const sim::NodeVectors& x, PassRecord* timing,
-                                 const std::vector<std::uint8_t>* boundary) {
+                                 const std::vector<std::uint8_t>* boundary, const std::vector<int>* renumber) {
   PassTimer timer;
 
   // Surface for contact and rendering: boundary faces, compacted vertex numbering.
@@ -276,7 +290,7 @@ Status Simulation::buildGeometry(const cutting::TetMesh& mesh, const sim::NodeVe
   timer.lap(timing ? &timing->surface_ms : nullptr);
   // The boundary's hierarchy, with boxes grown by half a millimetre: while the tissue near
   // the loop moves less than that, a step only moves the vertices (see collision.hpp).
-  if (Status st = collision_.build(surface_faces_, x, 0.5); !st.ok()) return st;
+  if (Status st = collision_.build(surface_faces_, x, 0.5, &mesh.X, renumber); !st.ok()) return st;
   timer.lap(timing ? &timing->collision_ms : nullptr);
   return Status::Ok();
 }
@@ -692,10 +706,24 @@ void Simulation::finishPass() {
   // Chips: pieces connected to no anchored node are removed (their volume is resected).
   // Face neighbours of the cut mesh: from the previous mesh's, rematching only the faces
   // near the cut (all faces when that cannot be done).
+  // When every piece before the cut was anchored and stays so, only the tets near the cut
+  // are searched (freePiecesAfterCut): the free pieces are the same, in the same order, and
+  // the number of pieces (rec.components) is counted after the pass, beside the locator.
   std::vector<int> face_next;
   Pieces comps;
-  if (updateFaces(mesh_, face_next_, after, change.node_old_to_new, change.element_old_to_new, face_next) ||
-      matchFaces(after, face_next)) {
+  FaceChange face_change;
+  bool near_cut = false;
+  if (updateFaces(mesh_, face_next_, after, change.node_old_to_new, change.element_old_to_new, face_next,
+                  &face_change)) {
+    near_cut = pieces_anchored_ && anchor_distance_.size() == static_cast<size_t>(mesh_.numTets()) &&
+               anchored_.size() == change.node_old_to_new.size();
+    for (size_t i = 0; i < change.node_old_to_new.size() && near_cut; ++i) {
+      const int j = change.node_old_to_new[i];
+      near_cut = !anchored_[i] || (j >= 0 && j < n && anchored_after[j]);
+    }
+    comps = near_cut ? freePiecesAfterCut(after, face_next, anchored_after, face_change, anchor_distance_)
+                     : tetPieces(after, face_next, anchored_after);
+  } else if (matchFaces(after, face_next)) {
     comps = tetPieces(after, face_next, anchored_after);
   } else {  // not reached for a valid mesh
     std::vector<int> anchored;
@@ -723,7 +751,7 @@ void Simulation::finishPass() {
     if (after.material[t] == myoma_label) rec.removed_myoma_mm3 += vol;
   }
   for (int c = 0; c < comps.count; ++c) rec.chips += comps.free[c] ? 1 : 0;
-  rec.components = comps.count;
+  rec.components = comps.count;  // near_cut: replaced after the pass
   // The kept nodes, renumbered in their order (so the model's arrays compact in place).
   std::vector<std::int32_t> new_index(n, -1);
   for (int t : keep_tets)
@@ -731,31 +759,6 @@ void Simulation::finishPass() {
   int kept_nodes = 0;
   for (int i = 0; i < n; ++i)
     if (new_index[i] == 0) new_index[i] = kept_nodes++;
-  cutting::TetMesh rest_mesh;
-  rest_mesh.X.resize(kept_nodes, 3);
-  sim::NodeVectors x_kept(kept_nodes, 3), v_kept(kept_nodes, 3);
-  std::vector<std::uint8_t> anchored_kept(static_cast<size_t>(kept_nodes), 0);
-  for (int i = 0; i < n; ++i) {
-    if (new_index[i] < 0) continue;
-    rest_mesh.X.row(new_index[i]) = rest.row(i);
-    x_kept.row(new_index[i]) = xnew.row(i);
-    v_kept.row(new_index[i]) = v.row(i);
-    anchored_kept[new_index[i]] = anchored_after[i];
-  }
-  rest_mesh.T.resize(static_cast<Eigen::Index>(keep_tets.size()), 4);
-  rest_mesh.material.resize(static_cast<Eigen::Index>(keep_tets.size()));
-  for (size_t k = 0; k < keep_tets.size(); ++k) {
-    for (int c = 0; c < 4; ++c) rest_mesh.T(static_cast<Eigen::Index>(k), c) = new_index[after.T(keep_tets[k], c)];
-    rest_mesh.material[static_cast<Eigen::Index>(k)] = after.material[keep_tets[k]];
-  }
-  // Its boundary: the kept tets' faces that no other tet shares (a kept tet's neighbours
-  // are in its component, so kept too), in the order cutting::boundaryFaces gives.
-  std::vector<std::uint8_t> kept_boundary;
-  if (!face_next.empty()) {
-    kept_boundary.resize(4 * keep_tets.size());
-    for (size_t k = 0; k < keep_tets.size(); ++k)
-      for (int f = 0; f < 4; ++f) kept_boundary[4 * k + f] = face_next[4 * static_cast<size_t>(keep_tets[k]) + f] < 0;
-  }
   // Nodes on a cut surface, this pass's and earlier ones', in the new numbering.
   std::vector<std::uint8_t> on_cut(n, 0);
   for (int i = 0; i < static_cast<int>(change.node_old_to_new.size()); ++i) {
@@ -769,18 +772,56 @@ void Simulation::finishPass() {
   for (int i = 0; i < n; ++i) {
     if (new_index[i] >= 0) on_cut_[new_index[i]] = on_cut[i];
   }
-  // Meanwhile a second thread builds the kept mesh's boundary, render surface and FCL
-  // hierarchy (buildGeometry), as soon as its inputs exist: they depend on the kept mesh,
-  // positions and on-cut flags only, what this thread does until the join (face neighbours,
-  // serosa, chips, the model update) on none of them, and each writes its own members, so
-  // the result is the same as one after the other.
+  // Meanwhile a second thread compacts the kept mesh and builds its boundary, render surface
+  // and FCL hierarchy (buildGeometry), as soon as their inputs exist: they depend on the cut
+  // mesh, positions, pieces and on-cut flags only, which this thread only reads until the join
+  // (serosa, chips, the model update), none of which depends on them, and each writes its own
+  // members, so the result is the same as one after the other.
+  // The old mesh's nodes in the kept numbering (the collision hierarchy's and the serosa's).
+  std::vector<int> old_to_kept(change.node_old_to_new.size(), -1);
+  for (size_t i = 0; i < change.node_old_to_new.size(); ++i) {
+    const int j = change.node_old_to_new[i];
+    if (j >= 0 && j < n) old_to_kept[i] = new_index[j];
+  }
+  // The kept mesh (rest positions, tets), its positions, velocities and anchors, and its
+  // boundary: the kept tets' faces that no other tet shares (a kept tet's neighbours are in
+  // its component, so kept too), in the order cutting::boundaryFaces gives. Made on the
+  // geometry thread (nothing on this one reads them before the join), which then also finds
+  // the kept mesh's face neighbours, for the next pass (a kept tet's neighbours are kept).
+  cutting::TetMesh rest_mesh;
+  sim::NodeVectors x_kept, v_kept;
+  std::vector<std::uint8_t> anchored_kept, kept_boundary;
   Status geometry;
-  std::thread geometry_thread([&] {
-    geometry = buildGeometry(rest_mesh, x_kept, &rec, kept_boundary.empty() ? nullptr : &kept_boundary);
-  });
-  // The kept mesh's face neighbours, for the next pass (a kept tet's neighbours are kept).
   std::vector<int> kept_next;
-  if (!face_next.empty()) {
+  std::thread geometry_thread([&] {
+    rest_mesh.X.resize(kept_nodes, 3);
+    x_kept.resize(kept_nodes, 3);
+    v_kept.resize(kept_nodes, 3);
+    anchored_kept.assign(static_cast<size_t>(kept_nodes), 0);
+    for (int i = 0; i < n; ++i) {
+      if (new_index[i] < 0) continue;
+      rest_mesh.X.row(new_index[i]) = rest.row(i);
+      x_kept.row(new_index[i]) = xnew.row(i);
+      v_kept.row(new_index[i]) = v.row(i);
+      anchored_kept[new_index[i]] = anchored_after[i];
+    }
+    rest_mesh.T.resize(static_cast<Eigen::Index>(keep_tets.size()), 4);
+    rest_mesh.material.resize(static_cast<Eigen::Index>(keep_tets.size()));
+    for (size_t k = 0; k < keep_tets.size(); ++k) {
+      for (int c = 0; c < 4; ++c) rest_mesh.T(static_cast<Eigen::Index>(k), c) = new_index[after.T(keep_tets[k], c)];
+      rest_mesh.material[static_cast<Eigen::Index>(k)] = after.material[keep_tets[k]];
+    }
+    if (!face_next.empty()) {
+      kept_boundary.resize(4 * keep_tets.size());
+      for (size_t k = 0; k < keep_tets.size(); ++k)
+        for (int f = 0; f < 4; ++f) kept_boundary[4 * k + f] = face_next[4 * static_cast<size_t>(keep_tets[k]) + f] < 0;
+    }
+    geometry = buildGeometry(rest_mesh, x_kept, &rec, kept_boundary.empty() ? nullptr : &kept_boundary, &old_to_kept);
+    if (face_next.empty()) return;
+    if (keep_tets.size() == static_cast<size_t>(after.numTets())) {  // no piece removed
+      kept_next = face_next;
+      return;
+    }
     std::vector<int> kept_of(static_cast<size_t>(after.numTets()), -1);
     for (size_t k = 0; k < keep_tets.size(); ++k) kept_of[keep_tets[k]] = static_cast<int>(k);
     kept_next.resize(4 * keep_tets.size());
@@ -793,13 +834,8 @@ void Simulation::finishPass() {
         }
         kept_next[4 * k + f] = p < 0 ? -1 : 4 * kept_of[p / 4] + p % 4;
       }
-  }
+  });
   // The serosa follows its nodes into the new numbering.
-  std::vector<int> old_to_kept(change.node_old_to_new.size(), -1);
-  for (size_t i = 0; i < change.node_old_to_new.size(); ++i) {
-    const int j = change.node_old_to_new[i];
-    if (j >= 0 && j < n) old_to_kept[i] = new_index[j];
-  }
   outer_wall_.remapNodes(old_to_kept);
   timer.lap(&rec.components_ms);
   std::vector<ChipShape> chip_shapes;
@@ -873,11 +909,17 @@ void Simulation::finishPass() {
   // until the next pass, which waits first) and its own copy of the positions at the cut,
   // so it is the same locator as one built here. Its time goes to this pass's locator_ms
   // (passes_ grows only in finishPass, after the wait).
+  // The same thread finds the new mesh's distances to the anchors for the next pass and, when
+  // this pass searched near its cut only, counts the pieces (the kept mesh's, all anchored,
+  // and the chips).
   double* locator_ms = &passes_.back().locator_ms;
-  locator_thread_ = std::thread([this, x = std::move(x_kept), locator_ms] {
+  int* components = near_cut ? &passes_.back().components : nullptr;
+  locator_thread_ = std::thread([this, x = std::move(x_kept), locator_ms, components, chips = rec.chips] {
     PassTimer build_timer;
     locator_.build(mesh_, x);
     buildNearest(mesh_, x);
+    const int kept_pieces = anchorPieces();
+    if (components != nullptr) *components = kept_pieces < 0 ? -1 : kept_pieces + chips;
     build_timer.lap(locator_ms);
   });
 }

@@ -6,6 +6,8 @@
 
 #include "alloc_counter.hpp"
 #include "box_mesh.hpp"
+#include "hysim/cutting/cut3d.hpp"
+#include "hysim/cutting/mesh_io.hpp"
 #include "hysim/engine/collision.hpp"
 #include "hysim/engine/tool.hpp"
 
@@ -209,11 +211,12 @@ TEST(Collision, UpdateWithAMarginStaysExact) {
   EXPECT_FALSE(rise(0.4));  // within the margin: no box changes
   EXPECT_EQ(collision.numLocalRefits(), 0);
   EXPECT_TRUE(rise(1.9));   // 0.1 mm below the wire
-  EXPECT_EQ(collision.numLocalRefits(), collision.numVertices());
+  EXPECT_EQ(collision.numLocalRefits(), collision.numHierarchyVertices());
+  EXPECT_GE(collision.numHierarchyVertices(), collision.numVertices());
   EXPECT_FALSE(rise(2.3));  // wire 0.3 mm inside: no surface within 0.15 mm
   EXPECT_FALSE(rise(1.5));
   EXPECT_TRUE(rise(1.88));
-  EXPECT_EQ(collision.numLocalRefits(), collision.numVertices());  // all within the margin since
+  EXPECT_EQ(collision.numLocalRefits(), collision.numHierarchyVertices());  // all within the margin since
 }
 
 // Random jitter of every vertex (a random walk, steps up to 0.4 mm): update() answers as a
@@ -248,6 +251,71 @@ TEST(Collision, UpdateAgreesWithAFreshHierarchy) {
   EXPECT_GT(touched, 30);
   EXPECT_GT(followed.numLocalRefits(), 0);
   EXPECT_EQ(followed.numRefits(), 1);  // the build's
+}
+
+// After a cut, a build that keeps the unchanged chunks (renumbered) answers every query as a
+// build from scratch does, and rebuilds only some of the chunks.
+TEST(Collision, AChunkedRebuildAfterACutAgreesWithAFreshOne) {
+  auto uterus = cutting::readTetMesh(std::string(HYSIM_SOURCE_DIR) + "/assets/uterus_myoma.msh");
+  ASSERT_TRUE(uterus.ok()) << uterus.error();
+  cutting::TetMesh mesh = *uterus;
+  TissueCollision followed;
+  ASSERT_TRUE(followed.build(cutting::boundaryFaces(mesh), mesh.X, 0.5, &mesh.X).ok());
+  const long first = followed.numChunksBuilt();
+  EXPECT_GT(first, 8);
+  const Eigen::Vector3d lo = mesh.X.colwise().minCoeff().transpose(), hi = mesh.X.colwise().maxCoeff().transpose();
+  LoopGeometry loop;
+  SweptWire sweep;
+  sweep.reset(loop.segments + 1);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (int cut = 0; cut < 3; ++cut) {
+    // A partial quad cut near the myoma, then a hybrid plane cut.
+    const Eigen::Vector3d c = lo + (hi - lo).cwiseProduct(Eigen::Vector3d(0.45 + 0.05 * cut, 0.35, 0.5));
+    Result<cutting::CutSurface> surface = cutting::CutSurface::plane(c, Eigen::Vector3d(0.1 * cut, 1.0, 0.2).normalized());
+    if (cut != 1) {
+      cutting::Positions v(4, 3);
+      v << c.x() - 6, c.y() - 0.3, c.z() - 6, c.x() + 6, c.y(), c.z() - 6, c.x() - 6, c.y(), c.z() + 6, c.x() + 6,
+          c.y() + 0.3, c.z() + 6;
+      cutting::Tris f(2, 3);
+      f << 0, 1, 3, 0, 3, 2;
+      surface = cutting::CutSurface::triangles(v, f);
+    }
+    ASSERT_TRUE(surface.ok());
+    cutting::Cut3DOptions options;
+    options.method = cutting::CutMethod::Hybrid;
+    auto r = cutting::cut3d(mesh, *surface, options);
+    ASSERT_TRUE(r.ok()) << r.error();
+    mesh = r->mesh;
+    const std::vector<int> renumber(r->change.node_old_to_new.begin(), r->change.node_old_to_new.end());
+    const cutting::Tris faces = cutting::boundaryFaces(mesh);
+    const long built = followed.numChunksBuilt(), kept = followed.numChunksKept();
+    ASSERT_TRUE(followed.build(faces, mesh.X, 0.5, &mesh.X, &renumber).ok());
+    EXPECT_GT(followed.numChunksKept(), kept) << "cut " << cut;
+    EXPECT_LT(followed.numChunksBuilt() - built, first / 2) << "cut " << cut;
+    TissueCollision fresh;
+    ASSERT_TRUE(fresh.build(faces, mesh.X, 0.5, &mesh.X).ok());
+    EXPECT_EQ(followed.numFaces(), fresh.numFaces());
+    EXPECT_EQ(followed.numVertices(), fresh.numVertices());
+    // Random short sweeps of the wire over the mesh's box.
+    int touched = 0;
+    for (int k = 0; k < 400; ++k) {
+      const Eigen::Vector3d p = lo + (hi - lo).cwiseProduct(Eigen::Vector3d(u(rng), u(rng), u(rng)));
+      haptics::ToolPose pose;
+      pose.rotation = haptics::frameFromAxisUp(Eigen::Vector3d(u(rng) - 0.5, u(rng) - 0.5, 1.0).normalized(), {0, 1, 0});
+      pose.tip = p;
+      WirePoints a, b;
+      loopPoints(loop, pose, a);
+      pose.tip += Eigen::Vector3d(u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5);
+      loopPoints(loop, pose, b);
+      sweep.update(a, b);
+      const bool expected = fresh.touches(sweep, loop.wire_radius_mm);
+      EXPECT_EQ(followed.touches(sweep, loop.wire_radius_mm), expected) << "cut " << cut << " sweep " << k;
+      touched += expected ? 1 : 0;
+    }
+    EXPECT_GT(touched, 40);
+    EXPECT_LT(touched, 360);
+  }
 }
 
 TEST(Collision, RefitUpdateAndQueryAllocateNothing) {

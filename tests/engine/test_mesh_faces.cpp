@@ -112,6 +112,76 @@ TEST(MeshFaces, UpdateAfterCutsMatchesMatchingAllFaces) {
   }
 }
 
+// The free pieces found near a cut are tetPieces' free pieces, in the same order, for cuts
+// that free one or more pieces and cuts that free none (a mesh of one anchored piece before).
+TEST(MeshFaces, FreePiecesNearTheCutAreThoseOfAllTets) {
+  auto uterus = cutting::readTetMesh(std::string(HYSIM_SOURCE_DIR) + "/assets/uterus_myoma.msh");
+  ASSERT_TRUE(uterus.ok()) << uterus.error();
+  int freed = 0, cuts = 0;
+  for (const cutting::TetMesh& start : {testing::boxTetMesh(6, 6, 6, 0.4), *uterus}) {
+    const Vec3 lo = start.X.colwise().minCoeff().transpose(), hi = start.X.colwise().maxCoeff().transpose();
+    // Anchored: the bottom tenth (z).
+    auto anchoredOf = [&](const cutting::TetMesh& m) {
+      std::vector<std::uint8_t> a(static_cast<size_t>(m.numNodes()), 0);
+      for (int i = 0; i < m.numNodes(); ++i) a[i] = m.X(i, 2) < lo.z() + 0.1 * (hi.z() - lo.z());
+      return a;
+    };
+    std::vector<int> next;
+    ASSERT_TRUE(matchFaces(start, next));
+    const std::vector<std::uint8_t> anchored_before = anchoredOf(start);
+    const std::vector<int> distance = anchorDistance(start, next, anchored_before);
+    ASSERT_EQ(tetPieces(start, next, anchored_before).count, 1);
+    for (int t = 0; t < start.numTets(); ++t) ASSERT_LT(distance[t], start.numTets());
+    for (int cut = 0; cut < 6; ++cut) {
+      // Planes tilted through the upper half (the top comes off) and quads into the side
+      // (nothing comes off, or a flap does).
+      const Vec3 c = lo + (hi - lo).cwiseProduct(Vec3(0.37 + 0.05 * cut, 0.43, 0.55 + 0.06 * cut));
+      const Vec3 d = (hi - lo) * 0.3;
+      Result<cutting::CutSurface> surface = cutting::CutSurface::plane(c, Vec3(0.1 * cut, 0.15, 1.0).normalized());
+      if (cut % 2 == 1) {
+        cutting::Positions v(4, 3);
+        v << c.x() - 3 * d.x(), c.y() - 3 * d.y(), c.z(), c.x() + d.x(), c.y() - 3 * d.y(), c.z() + 0.01 * d.z(),
+            c.x() - 3 * d.x(), c.y() + d.y(), c.z() + 0.02 * d.z(), c.x() + d.x(), c.y() + d.y(), c.z();
+        cutting::Tris f(2, 3);
+        f << 0, 1, 3, 0, 3, 2;
+        surface = cutting::CutSurface::triangles(v, f);
+      }
+      ASSERT_TRUE(surface.ok());
+      cutting::Cut3DOptions options;
+      options.method = cut < 4 ? cutting::CutMethod::Hybrid : cutting::CutMethod::Standard;
+      auto r = cutting::cut3d(start, *surface, options);
+      ASSERT_TRUE(r.ok()) << r.error();
+      const cutting::TetMesh& after = r->mesh;
+      std::vector<int> updated;
+      FaceChange change;
+      ASSERT_TRUE(updateFaces(start, next, after, r->change.node_old_to_new, r->change.element_old_to_new, updated,
+                              &change));
+      const std::vector<std::uint8_t> anchored = anchoredOf(after);
+      const Pieces all = tetPieces(after, updated, anchored);
+      const Pieces near = freePiecesAfterCut(after, updated, anchored, change, distance);
+      // The same free pieces: free tets alike, and the free pieces in the same order.
+      std::vector<int> all_order, near_order;  // free piece of each free tet, renumbered by first use
+      std::vector<int> all_seen(static_cast<size_t>(all.count), -1), near_seen(static_cast<size_t>(near.count), -1);
+      int all_n = 0, near_n = 0;
+      for (int t = 0; t < after.numTets(); ++t) {
+        const bool all_free = all.free[all.label[t]] != 0, near_free = near.free[near.label[t]] != 0;
+        ASSERT_EQ(all_free, near_free) << "cut " << cut << " tet " << t;
+        if (!all_free) continue;
+        if (all_seen[all.label[t]] < 0) all_seen[all.label[t]] = all_n++;
+        if (near_seen[near.label[t]] < 0) near_seen[near.label[t]] = near_n++;
+        EXPECT_EQ(all_seen[all.label[t]], near_seen[near.label[t]]) << "cut " << cut << " tet " << t;
+        EXPECT_EQ(near.label[t], near_seen[near.label[t]] + 1);  // numbered in order, from 1
+      }
+      EXPECT_EQ(near.count, near_n + 1);
+      EXPECT_EQ(near.free[0], 0);
+      freed += all_n;
+      ++cuts;
+    }
+  }
+  EXPECT_EQ(cuts, 12);
+  EXPECT_GE(freed, 4);
+}
+
 TEST(MeshFaces, AFaceSharedByThreeTetsJoinsThemAll) {
   // Not a valid mesh, but cutting::tetComponents joins all the tets of a face: so must this.
   cutting::TetMesh m;

@@ -32,9 +32,19 @@ bool matchFaces(const cutting::TetMesh& mesh, std::vector<int>& next);
 // them) are matched among themselves. Linear in #T with a small constant, sorting only the
 // slots near the cut. Returns false (next untouched) when it cannot tell: sizes that do not
 // match, a face of more than two elements, node ids out of range; matchFaces then.
+// What updateFaces finds on the way, for freePiecesAfterCut.
+struct FaceChange {
+  // #T of after: the element of before with the same nodes in the same order, or -1.
+  std::vector<int> old_of;
+  // Ascending: the tets of after with a face whose neighbour may differ from before (the
+  // slots matched anew), every tet whose old_of is -1 among them. Every other tet has the
+  // neighbours its old_of had, renumbered.
+  std::vector<int> near_cut;
+};
+// change (optional) is written when updateFaces returns true.
 bool updateFaces(const cutting::TetMesh& before, const std::vector<int>& next_before, const cutting::TetMesh& after,
                  const std::vector<std::int32_t>& node_old_to_new, const std::vector<std::int32_t>& element_old_to_new,
-                 std::vector<int>& next);
+                 std::vector<int>& next, FaceChange* change = nullptr);
 
 // Connected components through shared faces, numbered in the order of their first tet, and
 // whether each touches no anchored node: cutting::tetComponents' label, count and free (not
@@ -46,6 +56,29 @@ struct Pieces {
 };
 // anchored: #N flags.
 Pieces tetPieces(const cutting::TetMesh& mesh, const std::vector<int>& next, const std::vector<std::uint8_t>& anchored);
+
+// Per tet, the number of steps through shared faces to a tet with an anchored node (0 for
+// those), or INT_MAX where no such tet is connected. A breadth-first search from all of them.
+std::vector<int> anchorDistance(const cutting::TetMesh& mesh, const std::vector<int>& next,
+                                const std::vector<std::uint8_t>& anchored);
+
+// tetPieces' free pieces of `after`, a cut of `before`, found from the tets near the cut
+// (change.near_cut) instead of from all tets, where
+//   every piece of before had an anchored node, and every node of before that was anchored
+//   still is (its node in after);
+// then a piece of after without a tet near the cut is a piece of before (same tets, same
+// faces), anchored. A search from each tet near the cut not reached yet walks the shared faces
+// (next: updateFaces' next of after) until it meets an anchored node or a tet an earlier search
+// reached (anchored: a free piece is searched whole), or runs out of tets: then its tets are
+// a free piece. The search steps first to the neighbour nearest to the anchors before the cut
+// (distance_before: anchorDistance of before; tets without an old_of last), so an anchored
+// search usually ends after about that many steps.
+// Returns: label 0 for every tet not in a free piece (piece 0, not free), the free pieces
+// numbered 1, 2, ... in the order of their first tet (tetPieces' order of the free pieces),
+// count = 1 + the number of free pieces.
+Pieces freePiecesAfterCut(const cutting::TetMesh& after, const std::vector<int>& next,
+                          const std::vector<std::uint8_t>& anchored, const FaceChange& change,
+                          const std::vector<int>& distance_before);
 
 // The boundary faces (the slots whose next is -1) in slot order, nodes in kTetFace order,
 // and their tets: what cutting::boundaryFaces gives for the mesh. boundary: 4 #T flags.

@@ -39,7 +39,10 @@ struct PassRecord {
   // then waited for them (what they add to cut_ms), and other_ms is computed with
   // geometry_wait_ms in place of those two. The tet locator (locator_ms) is built on a
   // background thread after the pass has ended, beside the following steps, and is not part
-  // of cut_ms (at the start of a run, setTopology builds it in place).
+  // of cut_ms (at the start of a run, setTopology builds it in place); the same thread finds
+  // the new mesh's distances to the anchors (for the next pass's piece search) and, when the
+  // pass searched for free pieces near its cut only, counts `components`: locator_ms includes
+  // both.
   double map_ms = 0.0, cut3d_ms = 0.0, remap_ms = 0.0, components_ms = 0.0, model_ms = 0.0, surface_ms = 0.0,
          collision_ms = 0.0, locator_ms = 0.0, chips_ms = 0.0, stats_ms = 0.0, other_ms = 0.0,
          geometry_wait_ms = 0.0;
@@ -48,7 +51,7 @@ struct PassRecord {
   double removed_myoma_mm3 = 0.0;
   double sweep_area_mm2 = 0.0;  // area of the cut surface (the loop's sweep)
   int crossed_edges = 0, snapped_nodes = 0, split_edges = 0, duplicated_nodes = 0, cut_faces = 0;
-  int components = 0;
+  int components = 0;        // pieces of the cut mesh (chips included); passes() waits for it
   int substeps = 0;          // of the rebuilt model
   double added_mass_g = 0.0; // mass scaling needed to keep substeps within the cap (since the start)
   int stability_nodes = 0;   // free nodes of the model update's frequency estimate
@@ -151,9 +154,12 @@ class Simulation {
   // boundary faces, render surface and FCL hierarchy. It writes only those members
   // (surface_*, collision_) and reads on_cut_ and scene_, so a pass runs it on a second
   // thread beside the model update. Times surface_ms, collision_ms. (The tet locator is
-  // rebuildGeometry's, or the pass's background thread's.)
+  // rebuildGeometry's, or the pass's background thread's.) `renumber` (optional, #N of the
+  // mesh the hierarchy was last built for): the node each of its nodes became in `mesh`, or
+  // -1; with it, the hierarchy's chunks whose faces did not change are kept (see
+  // TissueCollision::build).
   Status buildGeometry(const cutting::TetMesh& mesh, const sim::NodeVectors& x, PassRecord* timing,
-                       const std::vector<std::uint8_t>* boundary);
+                       const std::vector<std::uint8_t>* boundary, const std::vector<int>* renumber = nullptr);
   // rebuildGeometry's second part, once mesh_, model_ and state_ are the new ones: contact
   // nodes and forces, collision flags, chips' cavity, topology version.
   void finishGeometry(PassRecord* timing);
@@ -218,6 +224,9 @@ class Simulation {
   // that reads locator_ (the buried test, the next pass, rebuildGeometry) waits first.
   mutable std::thread locator_thread_;
   void waitLocator() const;
+  // anchor_distance_ and pieces_anchored_ of mesh_, face_next_ and anchored_ (cleared and
+  // false when face_next_ is unknown); returns the number of pieces of mesh_ (-1: unknown).
+  int anchorPieces();
   Eigen::Matrix<double, Eigen::Dynamic, 3> wire_, previous_wire_;
   Sweep sweep_;
   std::vector<Eigen::Vector3d> rest_rows_;  // the open pass's kept rows, rest shape (mapSweepRows)
@@ -236,6 +245,11 @@ class Simulation {
   std::vector<std::uint8_t> anchored_;  // #N: rest position in an anchor region (fixed)
   std::vector<double> tet_quality_;     // #T: q* of each element (rest shape), for q_min
   std::vector<int> face_next_;          // 4 #T: matchFaces' next of mesh_ (empty: unknown)
+  // #T: anchorDistance of mesh_ (empty: unknown), and whether every piece of mesh_ has an
+  // anchored node (then a pass searches for free pieces near its cut only, see finishPass).
+  // After a pass both are computed on the locator's background thread.
+  std::vector<int> anchor_distance_;
+  bool pieces_anchored_ = false;
   double initial_myoma_mm3_ = 0.0;
   double electrode_active_s_ = 0.0;
   double path_length_mm_ = 0.0;
