@@ -1018,6 +1018,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   // Curved cuts, last (after flap peeling): only edges of tets below flap_quality, and a node
   // already non-manifold may stay so (see below).
   bool lastResort = false;
+  std::vector<std::uint8_t> isSeed, tetChanged;  // collapseEdges: per node, per tet
   auto collapseEdges = [&]() {
     if (!(options.collapse_fraction > 0)) return;
     std::vector<std::uint8_t> locked(N, 0);
@@ -1028,6 +1029,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       std::int32_t u, v;
       bool shortEdge;
       bool offCut;  // v is not on the cut (curved cuts, collapse_off_cut)
+      std::int32_t tet;  // the tet it came from
     };
     const bool offCutToo = curved && options.collapse_off_cut;
     // Does node n have a boundary face?
@@ -1036,14 +1038,12 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       discAround(n, vstar, true);
       return !link.empty();
     };
-    for (int batch = 0; batch < 3; ++batch) {
-      std::vector<Cand> cands;
-      std::vector<std::int32_t> seen;
-      regionTets(seen);
-      for (int t : seen) {
-        if ((*dead)[t]) continue;
+    // The candidates of tet t (edges of a poor tet, short edges), appended to `out`.
+    auto candidatesOf = [&](int t, std::vector<Cand>& out) {
+      if ((*dead)[t]) return;
+      {
         const double q = tetQ(t);
-        if (lastResort && !(q < options.flap_quality)) continue;
+        if (lastResort && !(q < options.flap_quality)) return;
         double mean = 0, lens[6];
         for (int a = 0, e = 0; a < 4; ++a)
           for (int b = a + 1; b < 4; ++b, ++e) {
@@ -1056,32 +1056,80 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
             const double len = lens[e];
             const bool shortEdge = len < options.collapse_fraction * std::max(mean, region.edge_length);
             if (!shortEdge && q >= options.quality_target) continue;
-            if (onCut[y]) cands.push_back({len, x, y, shortEdge, false});
-            if (onCut[x]) cands.push_back({len, y, x, shortEdge, false});
+            if (onCut[y]) out.push_back({len, x, y, shortEdge, false, t});
+            if (onCut[x]) out.push_back({len, y, x, shortEdge, false, t});
             if (offCutToo && !onCut[x] && !onCut[y]) {
-              cands.push_back({len, x, y, shortEdge, true});
-              cands.push_back({len, y, x, shortEdge, true});
+              out.push_back({len, x, y, shortEdge, true, t});
+              out.push_back({len, y, x, shortEdge, true, t});
             }
           }
       }
-      std::sort(cands.begin(), cands.end(), [](const Cand& p, const Cand& q) {
+    };
+    // The candidates of all region tets (`raw`, with copies). A batch changes only the tets
+    // of its collapses (removed, or a node replaced: `changedTets`) and nothing else a
+    // candidate depends on (positions, the cut flags): the next batch keeps the candidates of
+    // the other tets and takes those of the changed ones anew (where they are still region
+    // tets: with a seed node). The sorted and merged list below is the same as from scratch.
+    if (isSeed.empty()) {
+      isSeed.assign(N, 0);
+      for (int n : seeds) isSeed[n] = 1;
+    }
+    if (tetChanged.empty()) tetChanged.assign(M, 0);
+    std::vector<Cand> raw, cands;
+    std::vector<std::int32_t> changedTets;
+    // Sorted by length (then ends); an edge comes once per poor tet around it: one candidate
+    // per (u, v), short if any of its copies is (a short edge's test accepts what the other
+    // accepts, and copies would be tried one after the other on the same mesh).
+    auto sortMerge = [](std::vector<Cand>& c) {
+      std::sort(c.begin(), c.end(), [](const Cand& p, const Cand& q) {
         return p.len != q.len ? p.len < q.len : p.u != q.u ? p.u < q.u : p.v < q.v;
       });
-      // An edge comes once per poor tet around it: one candidate per (u, v), short if any
-      // of its copies is (a short edge's test accepts what the other accepts, and copies
-      // would be tried one after the other on the same mesh).
-      {
-        size_t kept = 0;
-        for (size_t i = 0; i < cands.size(); ++i) {
-          if (kept > 0 && cands[kept - 1].len == cands[i].len && cands[kept - 1].u == cands[i].u &&
-              cands[kept - 1].v == cands[i].v) {
-            cands[kept - 1].shortEdge = cands[kept - 1].shortEdge || cands[i].shortEdge;
-            continue;
-          }
-          cands[kept++] = cands[i];
+      size_t kept = 0;
+      for (size_t i = 0; i < c.size(); ++i) {
+        if (kept > 0 && c[kept - 1].len == c[i].len && c[kept - 1].u == c[i].u && c[kept - 1].v == c[i].v) {
+          c[kept - 1].shortEdge = c[kept - 1].shortEdge || c[i].shortEdge;
+          continue;
         }
-        cands.resize(kept);
+        c[kept++] = c[i];
       }
+      c.resize(kept);
+    };
+    for (int batch = 0; batch < 3; ++batch) {
+      if (batch == 0) {
+        std::vector<std::int32_t> seen;
+        regionTets(seen);
+        raw.clear();
+        for (int t : seen) candidatesOf(t, raw);
+      } else {
+        for (int t : changedTets) tetChanged[t] = 1;
+        raw.erase(std::remove_if(raw.begin(), raw.end(),
+                                 [&](const Cand& c) { return (*dead)[c.tet] || tetChanged[c.tet]; }),
+                  raw.end());
+        for (int t : changedTets) {
+          if (!tetChanged[t]) continue;  // (a tet changed twice: once)
+          tetChanged[t] = 0;
+          bool inRegion = false;
+          for (int k = 0; k < 4; ++k) inRegion = inRegion || isSeed[mesh.T(t, k)];
+          if (inRegion) candidatesOf(t, raw);
+        }
+        changedTets.clear();
+      }
+      cands.assign(raw.begin(), raw.end());
+      sortMerge(cands);
+#ifdef HYSIM_CHECK_EXACT
+      {  // the same list as from scratch
+        std::vector<std::int32_t> seen;
+        std::vector<Cand> ref;
+        regionTets(seen);
+        for (int t : seen) candidatesOf(t, ref);
+        sortMerge(ref);
+        bool same = ref.size() == cands.size();
+        for (size_t i = 0; i < ref.size() && same; ++i)
+          same = std::memcmp(&ref[i].len, &cands[i].len, sizeof(double)) == 0 && ref[i].u == cands[i].u &&
+                 ref[i].v == cands[i].v && ref[i].shortEdge == cands[i].shortEdge && ref[i].offCut == cands[i].offCut;
+        if (!same) std::abort();
+      }
+#endif
       int done = 0;
       for (const Cand& c : cands) {
         const int u = c.u, v = c.v;
@@ -1218,6 +1266,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
           continue;
         }
         locked[u] = locked[v] = 1;
+        changedTets.insert(changedTets.end(), changing.begin(), changing.end());
         budget.spend(after - before);
         ++done;
         if (counts) {
