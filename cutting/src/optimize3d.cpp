@@ -312,13 +312,33 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   // tried first and the scan stops at the first tet at or below the floor; when it passes,
   // *q receives the worst q* (as starWorst).
   // (firstQ: tetQAt(first, n, y), which the caller has already computed.)
+  // The answer does not depend on the order of the tets (any at or below the floor: false;
+  // else the minimum): the tet that failed n's last such test (lastBelow[n], where it is
+  // still a live tet of n) is tried second, as it is likely to fail again.
+  std::vector<std::int32_t> lastBelow(N, -1);
   auto starAbove = [&](int n, const Vec3& y, int first, double firstQ, double floor, double* q) {
     double worst = firstQ;
     if (!(worst > floor)) return false;
-    for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s) {
-      if ((*s) == first || (*dead)[(*s)]) continue;
-      const double qt = tetQAt((*s), n, y);
+    int second = lastBelow[n];
+    if (second == first || second < 0 || (*dead)[second]) {
+      second = -1;
+    } else {
+      bool has = false;
+      for (int k = 0; k < 4; ++k) has = has || mesh.T(second, k) == n;
+      if (!has) second = -1;
+    }
+    if (second >= 0) {
+      const double qt = tetQAt(second, n, y);
       if (!(qt > floor)) return false;
+      worst = std::min(worst, qt);
+    }
+    for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s) {
+      if ((*s) == first || (*s) == second || (*dead)[(*s)]) continue;
+      const double qt = tetQAt((*s), n, y);
+      if (!(qt > floor)) {
+        lastBelow[n] = *s;
+        return false;
+      }
       worst = std::min(worst, qt);
     }
     *q = std::min(1.0, worst);
