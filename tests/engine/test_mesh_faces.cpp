@@ -68,6 +68,19 @@ TEST(MeshFaces, SameAsCuttingOnTheUterus) {
   expectSameAsCutting(*mesh);
 }
 
+// The cut surface of the tests below: the plane through c with normal n or, when `quad`, a
+// nearly flat quad around c (corners 3 d below and d above c in x and y) that ends inside
+// the mesh (a partial cut).
+Result<cutting::CutSurface> planeOrQuad(const Vec3& c, const Vec3& d, const Vec3& n, bool quad) {
+  if (!quad) return cutting::CutSurface::plane(c, n.normalized());
+  cutting::Positions v(4, 3);
+  v << c.x() - 3 * d.x(), c.y() - 3 * d.y(), c.z(), c.x() + d.x(), c.y() - 3 * d.y(), c.z() + 0.01 * d.z(),
+      c.x() - 3 * d.x(), c.y() + d.y(), c.z() + 0.02 * d.z(), c.x() + d.x(), c.y() + d.y(), c.z();
+  cutting::Tris f(2, 3);
+  f << 0, 1, 3, 0, 3, 2;
+  return cutting::CutSurface::triangles(v, f);
+}
+
 // updateFaces after a sequence of cuts (through, partial, hybrid and standard, on the uterus
 // and a box) gives exactly matchFaces' next of the cut mesh, and refuses mismatched input.
 TEST(MeshFaces, UpdateAfterCutsMatchesMatchingAllFaces) {
@@ -82,15 +95,7 @@ TEST(MeshFaces, UpdateAfterCutsMatchesMatchingAllFaces) {
       const Vec3 c = lo + (hi - lo).cwiseProduct(Vec3(0.31 + 0.11 * cut, 0.47, 0.29 + 0.13 * cut));
       const Vec3 d = (hi - lo) * 0.3;
       // A quad that ends inside the mesh (partial) for odd cuts, a plane for even ones.
-      Result<cutting::CutSurface> surface = cutting::CutSurface::plane(c, Vec3(0.2 * cut, 0.1, 1.0).normalized());
-      if (cut % 2 == 1) {
-        cutting::Positions v(4, 3);
-        v << c.x() - 3 * d.x(), c.y() - 3 * d.y(), c.z(), c.x() + d.x(), c.y() - 3 * d.y(), c.z() + 0.01 * d.z(),
-            c.x() - 3 * d.x(), c.y() + d.y(), c.z() + 0.02 * d.z(), c.x() + d.x(), c.y() + d.y(), c.z();
-        cutting::Tris f(2, 3);
-        f << 0, 1, 3, 0, 3, 2;
-        surface = cutting::CutSurface::triangles(v, f);
-      }
+      const Result<cutting::CutSurface> surface = planeOrQuad(c, d, Vec3(0.2 * cut, 0.1, 1.0), cut % 2 == 1);
       ASSERT_TRUE(surface.ok());
       cutting::Cut3DOptions options;
       options.method = cut < 2 ? cutting::CutMethod::Hybrid : cutting::CutMethod::Standard;
@@ -137,15 +142,7 @@ TEST(MeshFaces, FreePiecesNearTheCutAreThoseOfAllTets) {
       // (nothing comes off, or a flap does).
       const Vec3 c = lo + (hi - lo).cwiseProduct(Vec3(0.37 + 0.05 * cut, 0.43, 0.55 + 0.06 * cut));
       const Vec3 d = (hi - lo) * 0.3;
-      Result<cutting::CutSurface> surface = cutting::CutSurface::plane(c, Vec3(0.1 * cut, 0.15, 1.0).normalized());
-      if (cut % 2 == 1) {
-        cutting::Positions v(4, 3);
-        v << c.x() - 3 * d.x(), c.y() - 3 * d.y(), c.z(), c.x() + d.x(), c.y() - 3 * d.y(), c.z() + 0.01 * d.z(),
-            c.x() - 3 * d.x(), c.y() + d.y(), c.z() + 0.02 * d.z(), c.x() + d.x(), c.y() + d.y(), c.z();
-        cutting::Tris f(2, 3);
-        f << 0, 1, 3, 0, 3, 2;
-        surface = cutting::CutSurface::triangles(v, f);
-      }
+      const Result<cutting::CutSurface> surface = planeOrQuad(c, d, Vec3(0.1 * cut, 0.15, 1.0), cut % 2 == 1);
       ASSERT_TRUE(surface.ok());
       cutting::Cut3DOptions options;
       options.method = cut < 4 ? cutting::CutMethod::Hybrid : cutting::CutMethod::Standard;
