@@ -186,16 +186,22 @@ double topEigenvalue(const Model& m, const cutting::Positions& X, const std::vec
   // below scales it: the value the loop's step `size` would have had from it.
   Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig_exact(max_steps);
   Eigen::VectorXd exact_diag(max_steps), exact_sub(max_steps);
-  auto exactTheta = [&](int size) {
-    if (size == 1) return alpha[0];
+  // The first `size` rows of T into (diag, sub), divided by their largest entry, which is
+  // returned (as Eigen's dense compute() scales, so the values are the same to the last bit).
+  auto loadScaled = [&](int size, Eigen::VectorXd& diag, Eigen::VectorXd& sub) {
     double scale = 0.0;
     for (int i = 0; i < size; ++i) scale = std::max(scale, std::abs(alpha[i]));
     for (int i = 0; i + 1 < size; ++i) scale = std::max(scale, std::abs(beta[i]));
     if (scale == 0.0) scale = 1.0;
-    exact_diag.resize(size);
-    exact_sub.resize(size - 1);
-    for (int i = 0; i < size; ++i) exact_diag[i] = alpha[i] / scale;
-    for (int i = 0; i + 1 < size; ++i) exact_sub[i] = beta[i] / scale;
+    diag.resize(size);
+    sub.resize(size - 1);
+    for (int i = 0; i < size; ++i) diag[i] = alpha[i] / scale;
+    for (int i = 0; i + 1 < size; ++i) sub[i] = beta[i] / scale;
+    return scale;
+  };
+  auto exactTheta = [&](int size) {
+    if (size == 1) return alpha[0];
+    const double scale = loadScaled(size, exact_diag, exact_sub);
     eig_exact.computeFromTridiagonal(exact_diag, exact_sub, Eigen::EigenvaluesOnly);
     return eig_exact.eigenvalues()[size - 1] * scale;
   };
@@ -216,14 +222,7 @@ double topEigenvalue(const Model& m, const cutting::Positions& X, const std::vec
     // T is tridiagonal already: solved as such (Eigen's dense compute() would reduce it by
     // Householder reflections that are all the identity here, O(size^3) per step). Scaled as
     // compute() scales (by its largest entry), so the values are the same to the last bit.
-    double scale = 0.0;
-    for (int i = 0; i < size; ++i) scale = std::max(scale, std::abs(alpha[i]));
-    for (int i = 0; i + 1 < size; ++i) scale = std::max(scale, std::abs(beta[i]));
-    if (scale == 0.0) scale = 1.0;
-    tri_diag.resize(size);
-    tri_sub.resize(size - 1);
-    for (int i = 0; i < size; ++i) tri_diag[i] = alpha[i] / scale;
-    for (int i = 0; i + 1 < size; ++i) tri_sub[i] = beta[i] / scale;
+    const double scale = loadScaled(size, tri_diag, tri_sub);
     // Eigenvalues only until theta has settled: the Ritz vector (for the residual and the
     // mode) is needed only from then on.
     // Before first_needed, theta matters only to the breakdown test b <= 1e-14 |theta|; the
