@@ -245,20 +245,23 @@ TEST(TissueUpdate3D, IncrementalUpdateAfterAPartialCut) {
   EXPECT_NEAR(model.mass.sum(), built->mass.sum(), 1e-9 * built->mass.sum());
 }
 
-// Global Lanczos estimate of `model` as it is (nothing changed, every node's mode "near").
-double globalOmega(const Model& model, const cutting::TetMesh& mesh) {
+// Global Lanczos estimate of `model` as it is (nothing changed, every node's mode "near"),
+// with the Lanczos options of `base`; *steps (optional) gets the Lanczos steps taken.
+double globalOmega(const Model& model, const cutting::TetMesh& mesh, const CutUpdate3DOptions& base = {},
+                   int* steps = nullptr) {
   Model global = model;
   cutting::TopologyChange identity;
   identity.old_num_nodes = identity.new_num_nodes = mesh.numNodes();
   for (int i = 0; i < mesh.numNodes(); ++i) identity.node_old_to_new.push_back(i);
   for (int t = 0; t < mesh.numTets(); ++t) identity.element_old_to_new.push_back(t);
   std::vector<std::uint8_t> flags(model.fixed.begin(), model.fixed.end());
-  CutUpdate3DOptions options;
+  CutUpdate3DOptions options = base;
   options.mode_overlap = -1.0;
   options.max_held_estimates = 0;
   CutUpdate3DReport report;
   EXPECT_TRUE(updateModelAfterCut3D(global, mesh, mesh, identity, flags, {}, options, &report).ok());
   EXPECT_TRUE(report.global_stability);
+  if (steps) *steps = report.lanczos_steps;
   return global.omega_max;
 }
 
@@ -353,22 +356,6 @@ TEST(TissueUpdate3D, DefaultLanczosEstimateIsConverged) {
   auto built = modelHeldBelowHalf(mesh);
   ASSERT_TRUE(built.ok());
   Model model = *built;
-  auto estimate = [](const Model& m, const cutting::TetMesh& msh, const CutUpdate3DOptions& base, int* steps) {
-    Model copy = m;
-    cutting::TopologyChange identity;
-    identity.old_num_nodes = identity.new_num_nodes = msh.numNodes();
-    for (int i = 0; i < msh.numNodes(); ++i) identity.node_old_to_new.push_back(i);
-    for (int t = 0; t < msh.numTets(); ++t) identity.element_old_to_new.push_back(t);
-    std::vector<std::uint8_t> flags(m.fixed.begin(), m.fixed.end());
-    CutUpdate3DOptions options = base;
-    options.mode_overlap = -1.0;
-    options.max_held_estimates = 0;
-    CutUpdate3DReport report;
-    EXPECT_TRUE(updateModelAfterCut3D(copy, msh, msh, identity, flags, {}, options, &report).ok());
-    EXPECT_TRUE(report.global_stability);
-    *steps = report.lanczos_steps;
-    return copy.omega_max;
-  };
   CutUpdate3DOptions converged;
   converged.lanczos_steps = 400;
   converged.lanczos_min_steps = 150;
@@ -384,8 +371,8 @@ TEST(TissueUpdate3D, DefaultLanczosEstimateIsConverged) {
       mesh = r->mesh;
     }
     int steps = 0, steps_converged = 0;
-    const double omega = estimate(model, mesh, {}, &steps);
-    const double omega_converged = estimate(model, mesh, converged, &steps_converged);
+    const double omega = globalOmega(model, mesh, {}, &steps);
+    const double omega_converged = globalOmega(model, mesh, converged, &steps_converged);
     EXPECT_LE(omega, omega_converged * (1.0 + 1e-9)) << "cut " << cut;
     EXPECT_GE(omega, omega_converged * (1.0 - 1e-3)) << "cut " << cut << ", " << steps << " steps";
     EXPECT_LT(steps, steps_converged);
