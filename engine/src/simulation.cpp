@@ -168,14 +168,14 @@ Status Simulation::setTopology(cutting::TetMesh rest_mesh, const sim::NodeVector
   model_ = std::move(model.value());
   resetState(x, v);
   if (!matchFaces(mesh_, face_next_)) face_next_.clear();
-  anchorPieces();
+  anchorPieces(false);
   timer.lap(timing ? &timing->model_ms : nullptr);
   tet_quality_.resize(static_cast<size_t>(mesh_.numTets()));
   for (int t = 0; t < mesh_.numTets(); ++t) tet_quality_[t] = tetQuality(mesh_, t);
   return rebuildGeometry(timing);
 }
 
-int Simulation::anchorPieces() {
+int Simulation::anchorPieces(bool count) {
   anchor_distance_.clear();
   pieces_anchored_ = false;
   if (face_next_.size() != 4 * static_cast<size_t>(mesh_.numTets()) ||
@@ -185,7 +185,7 @@ int Simulation::anchorPieces() {
   anchor_distance_ = anchorDistance(mesh_, face_next_, anchored_);
   pieces_anchored_ = std::find(anchor_distance_.begin(), anchor_distance_.end(), std::numeric_limits<int>::max()) ==
                      anchor_distance_.end();
-  return tetPieces(mesh_, face_next_, anchored_).count;
+  return count ? tetPieces(mesh_, face_next_, anchored_).count : 0;
 }
 
 double Simulation::tetQuality(const cutting::TetMesh& mesh, int t) {
@@ -918,7 +918,7 @@ void Simulation::finishPass() {
     PassTimer build_timer;
     locator_.build(mesh_, x);
     buildNearest(mesh_, x);
-    const int kept_pieces = anchorPieces();
+    const int kept_pieces = anchorPieces(components != nullptr);
     if (components != nullptr) *components = kept_pieces < 0 ? -1 : kept_pieces + chips;
     build_timer.lap(locator_ms);
   });

@@ -225,8 +225,9 @@ class Simulation {
   mutable std::thread locator_thread_;
   void waitLocator() const;
   // anchor_distance_ and pieces_anchored_ of mesh_, face_next_ and anchored_ (cleared and
-  // false when face_next_ is unknown); returns the number of pieces of mesh_ (-1: unknown).
-  int anchorPieces();
+  // false when face_next_ is unknown); with count, returns the number of pieces of mesh_
+  // (a whole labelling; -1: unknown), else 0.
+  int anchorPieces(bool count);
   Eigen::Matrix<double, Eigen::Dynamic, 3> wire_, previous_wire_;
   Sweep sweep_;
   std::vector<Eigen::Vector3d> rest_rows_;  // the open pass's kept rows, rest shape (mapSweepRows)
