@@ -81,6 +81,16 @@ Result<cutting::CutSurface> planeOrQuad(const Vec3& c, const Vec3& d, const Vec3
   return cutting::CutSurface::triangles(v, f);
 }
 
+// `mesh` cut by planeOrQuad(c, d, n, quad) with `method`.
+Result<cutting::Cut3DResult> cutPlaneOrQuad(const cutting::TetMesh& mesh, const Vec3& c, const Vec3& d, const Vec3& n,
+                                            bool quad, cutting::CutMethod method) {
+  const Result<cutting::CutSurface> surface = planeOrQuad(c, d, n, quad);
+  if (!surface.ok()) return Error{surface.error()};
+  cutting::Cut3DOptions options;
+  options.method = method;
+  return cutting::cut3d(mesh, *surface, options);
+}
+
 // updateFaces after a sequence of cuts (through, partial, hybrid and standard, on the uterus
 // and a box) gives exactly matchFaces' next of the cut mesh, and refuses mismatched input.
 TEST(MeshFaces, UpdateAfterCutsMatchesMatchingAllFaces) {
@@ -95,11 +105,8 @@ TEST(MeshFaces, UpdateAfterCutsMatchesMatchingAllFaces) {
       const Vec3 c = lo + (hi - lo).cwiseProduct(Vec3(0.31 + 0.11 * cut, 0.47, 0.29 + 0.13 * cut));
       const Vec3 d = (hi - lo) * 0.3;
       // A quad that ends inside the mesh (partial) for odd cuts, a plane for even ones.
-      const Result<cutting::CutSurface> surface = planeOrQuad(c, d, Vec3(0.2 * cut, 0.1, 1.0), cut % 2 == 1);
-      ASSERT_TRUE(surface.ok());
-      cutting::Cut3DOptions options;
-      options.method = cut < 2 ? cutting::CutMethod::Hybrid : cutting::CutMethod::Standard;
-      auto r = cutting::cut3d(mesh, *surface, options);
+      auto r = cutPlaneOrQuad(mesh, c, d, Vec3(0.2 * cut, 0.1, 1.0), cut % 2 == 1,
+                              cut < 2 ? cutting::CutMethod::Hybrid : cutting::CutMethod::Standard);
       ASSERT_TRUE(r.ok()) << r.error();
       std::vector<int> updated, expected;
       ASSERT_TRUE(updateFaces(mesh, next, r->mesh, r->change.node_old_to_new, r->change.element_old_to_new, updated))
@@ -142,11 +149,8 @@ TEST(MeshFaces, FreePiecesNearTheCutAreThoseOfAllTets) {
       // (nothing comes off, or a flap does).
       const Vec3 c = lo + (hi - lo).cwiseProduct(Vec3(0.37 + 0.05 * cut, 0.43, 0.55 + 0.06 * cut));
       const Vec3 d = (hi - lo) * 0.3;
-      const Result<cutting::CutSurface> surface = planeOrQuad(c, d, Vec3(0.1 * cut, 0.15, 1.0), cut % 2 == 1);
-      ASSERT_TRUE(surface.ok());
-      cutting::Cut3DOptions options;
-      options.method = cut < 4 ? cutting::CutMethod::Hybrid : cutting::CutMethod::Standard;
-      auto r = cutting::cut3d(start, *surface, options);
+      auto r = cutPlaneOrQuad(start, c, d, Vec3(0.1 * cut, 0.15, 1.0), cut % 2 == 1,
+                              cut < 4 ? cutting::CutMethod::Hybrid : cutting::CutMethod::Standard);
       ASSERT_TRUE(r.ok()) << r.error();
       const cutting::TetMesh& after = r->mesh;
       std::vector<int> updated;
