@@ -1480,7 +1480,14 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
             if (a == u || b == u || !onCut[a] || !onCut[b]) continue;
             const Vec3 pa = pos(a), ab = pos(b) - pa;
             const double l2 = ab.squaredNorm();
-            if (l2 > 0) targets.push_back(pa + std::clamp((pos(u) - pa).dot(ab) / l2, 0.1, 0.9) * ab);
+            if (!(l2 > 0)) continue;
+            // A target equal (bit for bit) to an earlier one fails the same way: trySnap leaves
+            // everything as it was when it fails (the link edge (a, b) of u is in two tets).
+            const Vec3 y = pa + std::clamp((pos(u) - pa).dot(ab) / l2, 0.1, 0.9) * ab;
+            bool seen = false;
+            for (size_t k = 0; k < targets.size() && !seen; ++k)
+              seen = std::memcmp(targets[k].data(), y.data(), sizeof(double) * 3) == 0;
+            if (!seen) targets.push_back(y);
           }
       }
       for (const Vec3& y : targets) {
