@@ -727,12 +727,48 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   // volume stay exactly. Kept when the worst q* of the tets involved rises; the best flip
   // of a tet is taken. A 2-3 flip reuses the slot of a removed tet (none free: no 2-3).
   std::vector<std::int32_t> freeSlots;
+  // A candidate that found no flip in a round is not tried again in the next round of the same
+  // call while nothing it reads changed: it reads the stars of its nodes, the tets in them (and
+  // the stars of their nodes, for the existence checks) and how many free slots there are (as
+  // min(count, 2): one for a 2-3, up to two for an edge removal). Each flip's rebuilt stars
+  // mark (flipMark, with the flip's number) their nodes and the nodes of the tets around them;
+  // a tet or star changed anywhere the candidate reads marks one of its nodes.
+  struct FlipFailed {
+    std::int32_t t, clock, avail;
+  };
+  std::vector<FlipFailed> failedPrev, failedNow;
+  std::vector<std::int32_t> flipMark, flipRebuilt;
+  std::int32_t flipClock = 0;
   auto flips = [&]() {
     if (!curved || !(options.flip_quality > 0)) return;
     freeSlots.assign(killed.begin(), killed.end());
     std::sort(freeSlots.begin(), freeSlots.end());
     freeSlots.erase(std::unique(freeSlots.begin(), freeSlots.end()), freeSlots.end());
-    std::vector<std::int32_t> cands, edgeTets;
+    // The dead tets in freeSlots (the slots free for reuse), counted when first needed after
+    // each change.
+    int availNow = -1;
+    auto availSlots = [&]() {
+      if (availNow < 0) {
+        availNow = 0;
+        for (int fs : freeSlots) availNow += (*dead)[fs] ? 1 : 0;
+      }
+      return availNow;
+    };
+    failedPrev.clear();
+    failedNow.clear();
+    std::vector<std::int32_t> cands, edgeAll;
+    // The live tets around t's nodes 0, 1 and 2 (star order; t among them), each with, per
+    // position l (4 bits each), the mask of t's nodes equal to its node l: the face and edge
+    // searches below read them instead of scanning the stars again. hitsOf(m, S): how many
+    // positions hold one of t's nodes in S (the count the scans took).
+    struct NearTet {
+      std::int32_t s;
+      std::uint16_t m;
+    };
+    std::vector<NearTet> nearTets;
+    auto hitsOf = [](unsigned m, unsigned S) {
+      return int((m & S) != 0) + int(((m >> 4) & S) != 0) + int(((m >> 8) & S) != 0) + int(((m >> 12) & S) != 0);
+    };
     auto vol6 = [&](int a, int b, int c, int d) {
       const Vec3 p0 = pos(a);
       return (pos(b) - p0).dot((pos(c) - p0).cross(pos(d) - p0));
@@ -754,14 +790,60 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       cands.erase(std::remove_if(cands.begin(), cands.end(), [&](int t) { return !(tetQ(t) < options.flip_quality); }),
                   cands.end());
       int done = 0;
+      size_t fp = 0;
       for (int t : cands) {
         if ((*dead)[t]) continue;
         const double qt = tetQ(t);
         if (!(qt < options.flip_quality)) continue;
+        while (fp < failedPrev.size() && failedPrev[fp].t < t) ++fp;
+        if (fp < failedPrev.size() && failedPrev[fp].t == t) {
+          const FlipFailed& prev = failedPrev[fp];
+          bool same = std::min(availSlots(), 2) == prev.avail;
+          for (int k = 0; k < 4 && same && !flipMark.empty(); ++k) same = flipMark[mesh.T(t, k)] <= prev.clock;
+          if (same) {
+            failedNow.push_back(prev);
+            continue;
+          }
+        }
         // Best flip: kind 0 = 2-3 across face f (neighbour u), kind 1 = 3-2 about edge (i, j).
         double best = qt;
         int bestKind = -1, bestF = -1, bestU = -1, bestI = -1, bestJ = -1;
         std::int32_t ring[3] = {-1, -1, -1}, ringTets[3] = {-1, -1, -1};
+        // Nothing changes below until the best flip is applied.
+        int nearOff[4];
+        nearTets.clear();
+        {
+          const int t0 = mesh.T(t, 0), t1 = mesh.T(t, 1), t2 = mesh.T(t, 2), t3 = mesh.T(t, 3);
+          for (int i = 0; i < 3; ++i) {
+            nearOff[i] = static_cast<int>(nearTets.size());
+            for (const std::int32_t *s = starB(mesh.T(t, i)), *sEnd = starE(mesh.T(t, i)); s < sEnd; ++s) {
+              if ((*dead)[*s]) continue;
+              unsigned m = 0;
+              for (int l = 0; l < 4; ++l) {
+                const int w = mesh.T(*s, l);
+                m |= (unsigned(w == t0) | unsigned(w == t1) << 1 | unsigned(w == t2) << 2 | unsigned(w == t3) << 3) << (4 * l);
+              }
+              nearTets.push_back({*s, static_cast<std::uint16_t>(m)});
+            }
+          }
+          nearOff[3] = static_cast<int>(nearTets.size());
+        }
+        // The tets around each edge (i, j) of t, i < j (from the list of node i, in its order).
+        int edgeOff[7], edgeSameMat[6];
+        edgeAll.clear();
+        for (int i = 0, e = 0; i < 4; ++i)
+          for (int j = i + 1; j < 4; ++j, ++e) {
+            edgeOff[e] = static_cast<int>(edgeAll.size());
+            const unsigned S = (1u << i) | (1u << j);
+            bool sameMat = true;
+            for (int k = nearOff[i]; k < nearOff[i + 1]; ++k)
+              if (hitsOf(nearTets[k].m, S) == 2) {
+                edgeAll.push_back(nearTets[k].s);
+                sameMat = sameMat && mesh.material(nearTets[k].s) == mesh.material(t);
+              }
+            edgeSameMat[e] = sameMat;
+          }
+        edgeOff[6] = static_cast<int>(edgeAll.size());
         // 2-3.
         const bool slot = [&]() {
           while (!freeSlots.empty() && !(*dead)[freeSlots.back()]) freeSlots.pop_back();
@@ -771,11 +853,11 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
           const int a = mesh.T(t, kFace[f][0]), b = mesh.T(t, kFace[f][1]), c = mesh.T(t, kFace[f][2]),
                     d = mesh.T(t, f);
           int u = -1;
-          for (const std::int32_t *s = starB(a), *sEnd = starE(a); s < sEnd && u < 0; ++s) {
-            if (*s == t || (*dead)[*s]) continue;
-            int hits = 0;
-            for (int k = 0; k < 4; ++k) hits += mesh.T(*s, k) == a || mesh.T(*s, k) == b || mesh.T(*s, k) == c;
-            if (hits == 3) u = *s;
+          {
+            const int li = kFace[f][0];  // a = t's node li
+            const unsigned S = (1u << kFace[f][0]) | (1u << kFace[f][1]) | (1u << kFace[f][2]);
+            for (int k = nearOff[li]; k < nearOff[li + 1] && u < 0; ++k)
+              if (nearTets[k].s != t && hitsOf(nearTets[k].m, S) == 3) u = nearTets[k].s;
           }
           if (u < 0 || mesh.material(u) != mesh.material(t)) continue;
           int e = -1;
@@ -816,24 +898,16 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
           }
         }
         // 3-2.
-        for (int i = 0; i < 4; ++i)
-          for (int j = i + 1; j < 4; ++j) {
+        for (int i = 0, ei = 0; i < 4; ++i)
+          for (int j = i + 1; j < 4; ++j, ++ei) {
             const int a = mesh.T(t, i), b = mesh.T(t, j);
-            edgeTets.clear();
-            for (const std::int32_t *s = starB(a), *sEnd = starE(a); s < sEnd; ++s) {
-              if ((*dead)[*s]) continue;
-              int hits = 0;
-              for (int k = 0; k < 4; ++k) hits += mesh.T(*s, k) == a || mesh.T(*s, k) == b;
-              if (hits == 2) edgeTets.push_back(*s);
-            }
-            if (edgeTets.size() != 3) continue;
-            bool sameMat = true;
-            for (int u : edgeTets) sameMat = sameMat && mesh.material(u) == mesh.material(t);
-            if (!sameMat) continue;
+            const std::int32_t* edgeTets = edgeAll.data() + edgeOff[ei];
+            if (edgeOff[ei + 1] - edgeOff[ei] != 3) continue;
+            if (!edgeSameMat[ei]) continue;
             // The other two nodes of each tet; a closed ring uses each of three nodes twice.
             std::int32_t others[6], m = 0;
-            for (int u : edgeTets)
-              for (int k = 0; k < 4; ++k)
+            for (int r = 0; r < 3; ++r)
+              for (int k = 0, u = edgeTets[r]; k < 4; ++k)
                 if (mesh.T(u, k) != a && mesh.T(u, k) != b) others[m++] = mesh.T(u, k);
             if (m != 6) continue;
             std::int32_t p[3], np = 0;
@@ -857,7 +931,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
             }
             if (exists) continue;
             double old = 1.0;
-            for (int u : edgeTets) old = std::min(old, tetQ(u));
+            for (int r = 0; r < 3; ++r) old = std::min(old, tetQ(edgeTets[r]));
             const double va = vol6(p[0], p[1], p[2], a);
             const int top = va > 0 ? a : b, bottom = va > 0 ? b : a;
             const double qn = std::min(q4(p[0], p[1], p[2], top), q4(p[0], p[2], p[1], bottom));
@@ -879,24 +953,15 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
         std::int32_t erRing[6], erTets[6];
         int erN = 0, erApex = -1;
         if (options.edge_removal) {
-          int avail = 0;
-          for (int fs : freeSlots) avail += (*dead)[fs] ? 1 : 0;
-          for (int i = 0; i < 4; ++i)
-            for (int j = i + 1; j < 4; ++j) {
+          int avail = -1;  // the free slots, counted when first needed
+          for (int i = 0, ei = 0; i < 4; ++i)
+            for (int j = i + 1; j < 4; ++j, ++ei) {
               const int a = mesh.T(t, i), b = mesh.T(t, j);
-              edgeTets.clear();
-              bool sameMat = true;
-              for (const std::int32_t *s = starB(a), *sEnd = starE(a); s < sEnd; ++s) {
-                if ((*dead)[*s]) continue;
-                int hits = 0;
-                for (int k = 0; k < 4; ++k) hits += mesh.T(*s, k) == a || mesh.T(*s, k) == b;
-                if (hits == 2) {
-                  edgeTets.push_back(*s);
-                  sameMat = sameMat && mesh.material(*s) == mesh.material(t);
-                }
-              }
-              const int n = static_cast<int>(edgeTets.size());
-              if (n < 4 || n > 6 || n - 4 > avail || !sameMat) continue;
+              const std::int32_t* edgeTets = edgeAll.data() + edgeOff[ei];
+              const bool sameMat = edgeSameMat[ei] != 0;
+              const int n = edgeOff[ei + 1] - edgeOff[ei];
+              if (n > 4 && n <= 6 && avail < 0) avail = availSlots();
+              if (n < 4 || n > 6 || (n > 4 && n - 4 > avail) || !sameMat) continue;
               // The ring: each tet's other two nodes, chained into one cycle.
               std::int32_t pr[6][2], cyc[6], cycT[6];
               bool used[6] = {false, false, false, false, false, false};
@@ -931,7 +996,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
               }
               if (!closed) continue;
               double old = 1.0;
-              for (int u : edgeTets) old = std::min(old, tetQ(u));
+              for (int r = 0; r < n; ++r) old = std::min(old, tetQ(edgeTets[r]));
               for (int apex = 0; apex < n; ++apex) {
                 double qn = 1.0;
                 int sign = 0;
@@ -1021,8 +1086,24 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
           ++done;
           if (counts) ++counts->flips;
         }
-        if (bestKind >= 0) buildStars();
+        if (bestKind < 0) {
+          failedNow.push_back({t, flipClock, std::min(availSlots(), 2)});
+          continue;
+        }
+        ++flipClock;
+        availNow = -1;
+        flipRebuilt.assign(touchedList.begin(), touchedList.end());
+        buildStars();
+        if (flipMark.empty()) flipMark.assign(N, -1);
+        for (int y : flipRebuilt) {
+          flipMark[y] = flipClock;
+          for (const std::int32_t *s = starB(y), *sEnd = starE(y); s < sEnd; ++s)
+            if (!(*dead)[*s])
+              for (int k = 0; k < 4; ++k) flipMark[mesh.T(*s, k)] = flipClock;
+        }
       }
+      failedPrev.swap(failedNow);
+      failedNow.clear();
       if (done == 0) break;
     }
   };
