@@ -348,58 +348,86 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   // elsewhere), a table over pairs of them.
   std::vector<std::int32_t> nbrs, localId(N, -1), pairCount;
   // Where node n may move (see the file comment).
+  // The faces around n by the pair of their nodes other than n: where first seen (tet, face),
+  // how many tets use them, the table entry; pairCount is -1 everywhere between calls.
+  struct FaceUse {
+    std::int32_t t, f, count, key;
+  };
+  std::vector<FaceUse> consFaces;
+  std::vector<std::int32_t> consLocal;  // per live star tet: its tet, then its nodes' local numbers (n: -1)
+  // The boundary faces around n (used by one tet), in the order first seen.
   struct BFace {
     std::int32_t u, v;
     Vec3 area;  // outward area vector (x2 the area)
-    int count;
+    Vec3 unit;  // area.normalized()
   };
   std::vector<BFace> faces;
   auto constraintOf = [&](int n) {
     Constraint c;
     faces.clear();
+    consFaces.clear();
     // Faces by the pair of their nodes other than n (local numbers over n's neighbours).
     nbrs.clear();
-    for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s)
-      if (!(*dead)[*s])
+    const std::int32_t *sBegin = starB(n), *sEnd = starE(n);
+    if (consLocal.size() < 5 * static_cast<size_t>(sEnd - sBegin)) consLocal.resize(5 * static_cast<size_t>(sEnd - sBegin));
+    std::int32_t* cl = consLocal.data();
+    for (const std::int32_t* s = sBegin; s < sEnd; ++s)
+      if (!(*dead)[*s]) {
+        *cl++ = *s;
         for (int k = 0; k < 4; ++k) {
           const int w = mesh.T(*s, k);
-          if (w != n && localId[w] < 0) {
+          if (w == n) {
+            *cl++ = -1;
+            continue;
+          }
+          if (localId[w] < 0) {
             localId[w] = static_cast<std::int32_t>(nbrs.size());
             nbrs.push_back(w);
           }
+          *cl++ = localId[w];
         }
+      }
+    const std::int32_t* clEnd = cl;
     const size_t L = nbrs.size();
-    pairCount.assign(L * L, -1);  // index into faces
-    for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s) {
-      const int t = (*s);
-      if ((*dead)[t]) continue;
+    if (pairCount.size() < L * L) pairCount.assign(L * L, -1);  // index into consFaces
+    for (const std::int32_t* rec = consLocal.data(); rec < clEnd; rec += 5) {
+      const std::int32_t* lt = rec + 1;
       int ln = 0;
-      while (mesh.T(t, ln) != n) ++ln;
-      for (int f = 0; f < 4; ++f) {
-        if (f == ln) continue;
-        const int i0 = mesh.T(t, kFace[f][0]), i1 = mesh.T(t, kFace[f][1]), i2 = mesh.T(t, kFace[f][2]);
-        std::int32_t o[2], m = 0;
-        for (int v : {i0, i1, i2})
-          if (v != n) o[m++] = v;
-        if (o[0] > o[1]) std::swap(o[0], o[1]);
-        const std::int32_t a = localId[o[0]], b = localId[o[1]];
-        std::int32_t& at = pairCount[std::min(a, b) * L + std::max(a, b)];
+      while (lt[ln] >= 0) ++ln;
+      // The positions other than n's, p[0] < p[1] < p[2]; face f = p[r] (in f order) is the
+      // pair of the other two.
+      int p[3], np = 0;
+      for (int k = 0; k < 4; ++k)
+        if (k != ln) p[np++] = k;
+      for (int r = 0; r < 3; ++r) {
+        const std::int32_t x = lt[p[r == 0 ? 1 : 0]], y = lt[p[r == 2 ? 1 : 2]];
+        const std::int32_t key = std::min(x, y) * static_cast<std::int32_t>(L) + std::max(x, y);
+        std::int32_t& at = pairCount[key];
         if (at >= 0) {
-          ++faces[at].count;
+          ++consFaces[at].count;
         } else {
-          at = static_cast<std::int32_t>(faces.size());
-          faces.push_back({o[0], o[1], (pos(i1) - pos(i0)).cross(pos(i2) - pos(i0)), 1});
+          at = static_cast<std::int32_t>(consFaces.size());
+          consFaces.push_back({rec[0], p[r], 1, key});
         }
       }
     }
     for (int w : nbrs) localId[w] = -1;
     Vec3 sum = Vec3::Zero();
     bool boundary = false, allCut = true;
-    for (const auto& bf : faces) {
-      if (bf.count != 1) continue;
+    for (const FaceUse& fu : consFaces) {
+      pairCount[fu.key] = -1;
+      if (fu.count != 1) continue;
+      const int t = fu.t;
+      const int i0 = mesh.T(t, kFace[fu.f][0]), i1 = mesh.T(t, kFace[fu.f][1]), i2 = mesh.T(t, kFace[fu.f][2]);
+      std::int32_t o[2], m = 0;
+      for (int v : {i0, i1, i2})
+        if (v != n) o[m++] = v;
+      if (o[0] > o[1]) std::swap(o[0], o[1]);
+      const Vec3 area = (pos(i1) - pos(i0)).cross(pos(i2) - pos(i0));
+      faces.push_back({o[0], o[1], area, area.normalized()});
       boundary = true;
-      sum += bf.area;
-      allCut = allCut && onCut[bf.u] && onCut[bf.v];
+      sum += area;
+      allCut = allCut && onCut[o[0]] && onCut[o[1]];
     }
     const bool nodeOnCut = onCut[n] != 0;
     // A node on a ridge (the rim, where the cut meets the boundary, or a crease of the
@@ -409,15 +437,14 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       if (!curved || !(options.ridge_deg > 0)) return false;
       int found = 0;
       for (size_t i = 0; i < faces.size(); ++i) {
-        if (faces[i].count != 1) continue;
         for (int w : {faces[i].u, faces[i].v})
           for (size_t j = i + 1; j < faces.size(); ++j) {
-            if (faces[j].count != 1 || (faces[j].u != w && faces[j].v != w)) continue;
+            if (faces[j].u != w && faces[j].v != w) continue;
             const bool cutI = onCut[faces[i].u] && onCut[faces[i].v] && nodeOnCut;
             const bool cutJ = onCut[faces[j].u] && onCut[faces[j].v] && nodeOnCut;
             // (On the cut only the rim counts: the node is put back onto the cut surface.)
             const bool edge = nodeOnCut ? cutI != cutJ
-                                        : faces[i].area.normalized().dot(faces[j].area.normalized()) < cosRidge;
+                                        : faces[i].unit.dot(faces[j].unit) < cosRidge;
             if (!edge) continue;
             if (found == 2) return false;
             c.ridge[found++] = pos(w);
@@ -445,7 +472,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       // volume changes by second-order amounts), where the cut faces around are smooth.
       c.kind = Freedom::Surface;
       for (const auto& bf : faces)
-        if (bf.count == 1 && bf.area.normalized().dot(c.normal) < cosCurved) c.kind = Freedom::Fixed;
+        if (bf.unit.dot(c.normal) < cosCurved) c.kind = Freedom::Fixed;
       return c;
     }
     if (!boundary) {
@@ -456,8 +483,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     c.normal = sum.normalized();
     c.kind = Freedom::Plane;
     for (const auto& bf : faces) {
-      if (bf.count != 1) continue;
-      const double cosine = bf.area.normalized().dot(c.normal);
+      const double cosine = bf.unit.dot(c.normal);
       if (cosine < cosCurved) {
         c.kind = Freedom::Fixed;
         ridgeOf();
@@ -467,8 +493,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     }
     if (c.kind == Freedom::Fan) {  // the node stays on its boundary faces as they are now
       fan.clear();
-      for (const auto& bf : faces)
-        if (bf.count == 1) fan.push_back({pos(n), pos(bf.u), pos(bf.v)});
+      for (const auto& bf : faces) fan.push_back({pos(n), pos(bf.u), pos(bf.v)});
     }
     return c;
   };
