@@ -1480,6 +1480,12 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     std::vector<std::uint32_t> groupVer;
     const double near = options.collapse_fraction * region.edge_length;
     auto inGroup = [&](int v) { return std::find(group.begin(), group.end(), v) != group.end(); };
+    // A retry (the group grown by a partner, nothing else changed: a failed trySnap leaves
+    // everything as it was) takes the volume and q* of each changing tet without the new
+    // member from the attempt before (prevGroup: its group size, 0 after a new group).
+    std::vector<std::int32_t> prevTets;
+    std::vector<double> prevVol, prevQ, curVol, curQ;
+    size_t prevGroup = 0;
     // Moves the group onto the cut and removes the tets that go flat, if that passes the
     // checks; otherwise leaves everything as it was and names a near node (not on the cut, not
     // in the group) of the tet that failed, if there is one.
@@ -1495,15 +1501,24 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       double oldMin = 1.0, newMin = 1.0, before = 0, after = 0;
       int worstTet = -1;
       matVol.clear();
-      for (int t : tets) {
+      const bool reuse = prevGroup > 0 && prevGroup + 1 == group.size();
+      const int added = reuse ? group.back() : -1;
+      size_t pi = 0;
+      // The last try of a chain (three nodes): the caller takes no partner from it, so it may
+      // stop at the first changing tet below the old minimum (then newMin < oldMin).
+      const bool last = group.size() >= 3;
+      if (last)
+        for (int t : tets) oldMin = std::min(oldMin, tetQ(t));
+      curVol.assign(tets.size(), 0.0);
+      curQ.assign(tets.size(), 0.0);
+      for (size_t ti = 0; ti < tets.size(); ++ti) {
+        const int t = tets[ti];
         int onAfter = 0;
-        Vec3 p[4];
+        bool hasAdded = false;
         for (int k = 0; k < 4; ++k) {
           const int v = mesh.T(t, k);
           onAfter += onCut[v] || inGroup(v);
-          p[k] = pos(v);
-          for (size_t g = 0; g < group.size(); ++g)
-            if (group[g] == v) p[k] = groupTo[g];
+          hasAdded = hasAdded || v == added;
         }
         oldMin = std::min(oldMin, tetQ(t));
         const double vt = tetVolumeHere(mesh, t);
@@ -1514,15 +1529,36 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
           continue;
         }
         changing.push_back(t);
-        const double vol = (p[1] - p[0]).dot((p[2] - p[0]).cross(p[3] - p[0])) / 6.0;
+        double vol, q;
+        while (reuse && pi < prevTets.size() && prevTets[pi] < t) ++pi;
+        if (reuse && !hasAdded && pi < prevTets.size() && prevTets[pi] == t) {
+          vol = prevVol[pi];
+          q = prevQ[pi];
+        } else {
+          Vec3 p[4];
+          for (int k = 0; k < 4; ++k) {
+            const int v = mesh.T(t, k);
+            p[k] = pos(v);
+            for (size_t g = 0; g < group.size(); ++g)
+              if (group[g] == v) p[k] = groupTo[g];
+          }
+          vol = (p[1] - p[0]).dot((p[2] - p[0]).cross(p[3] - p[0])) / 6.0;
+          q = vol > 0 ? radiusRatio(p[0], p[1], p[2], p[3]) : -1.0;
+        }
+        curVol[ti] = vol;
+        curQ[ti] = q;
         matAdd(t, vt, vol);
-        const double q = vol > 0 ? radiusRatio(p[0], p[1], p[2], p[3]) : -1.0;
         if (q < newMin) {
           newMin = q;
           worstTet = t;
         }
         after += vol;
+        if (last && newMin < oldMin) return false;
       }
+      prevGroup = group.size();
+      prevTets.assign(tets.begin(), tets.end());
+      prevVol.swap(curVol);
+      prevQ.swap(curQ);
       const double change = std::abs(after - before);
       if (newMin < oldMin && worstTet >= 0) {
         for (int k = 0; k < 4; ++k) {
@@ -1603,6 +1639,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
         // cut): they move to their nearest points of the cut.
         group.assign({u});
         groupTo.assign({y});
+        prevGroup = 0;
         bool done = false;
         while (!done) {
           int partner = -1;
