@@ -762,7 +762,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     std::int32_t t, clock, avail;
   };
   std::vector<FlipFailed> failedPrev, failedNow;
-  std::vector<std::int32_t> flipMark, flipRebuilt;
+  std::vector<std::int32_t> flipMark, flipRebuilt, flipChanged, flipSeeds;
   std::int32_t flipClock = 0;
   auto flips = [&]() {
     if (!curved || !(options.flip_quality > 0)) return;
@@ -802,6 +802,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       return vol6(a, b, c, d) > 0 ? radiusRatio(pos(a), pos(b), pos(c), pos(d)) : -1.0;
     };
     auto setTet = [&](int t, int a, int b, int c, int d) {
+      flipChanged.push_back(t);
       const int v[4] = {a, b, c, d};
       for (int k = 0; k < 4; ++k) {
         touch(mesh.T(t, k));
@@ -810,8 +811,33 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
         gained.emplace_back(v[k], t);
       }
     };
+    flipChanged.clear();
     for (int round = 0; round < 3; ++round) {
-      regionTets(cands);
+      if (round == 0) {
+        regionTets(cands);
+      } else {
+        // The region's tets now (every star rebuilt after the last flip): a tet no flip
+        // changed kept its nodes, its place in the region (a seed among its nodes) and its q*;
+        // the others were changed by setTet. So: the last round's candidates and the changed
+        // tets, live, with a seed among their nodes.
+        if (flipSeeds.empty()) {
+          flipSeeds.assign(seeds.begin(), seeds.end());
+          std::sort(flipSeeds.begin(), flipSeeds.end());
+        }
+        cands.insert(cands.end(), flipChanged.begin(), flipChanged.end());
+        std::sort(cands.begin(), cands.end());
+        cands.erase(std::unique(cands.begin(), cands.end()), cands.end());
+        cands.erase(std::remove_if(cands.begin(), cands.end(),
+                                   [&](int t) {
+                                     if ((*dead)[t]) return true;
+                                     bool in = false;
+                                     for (int k = 0; k < 4 && !in; ++k)
+                                       in = std::binary_search(flipSeeds.begin(), flipSeeds.end(), mesh.T(t, k));
+                                     return !in;
+                                   }),
+                    cands.end());
+        flipChanged.clear();
+      }
       cands.erase(std::remove_if(cands.begin(), cands.end(), [&](int t) { return !(tetQ(t) < options.flip_quality); }),
                   cands.end());
       int done = 0;
