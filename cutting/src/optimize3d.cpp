@@ -1503,6 +1503,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     std::sort(cands.begin(), cands.end());
     std::vector<std::int32_t> dying, changing, group, tets;
     std::vector<Vec3> targets, groupTo, groupFrom;
+    std::vector<std::uint64_t> targetEdges;
     std::vector<std::uint32_t> groupVer;
     const double near = options.collapse_fraction * region.edge_length;
     auto inGroup = [&](int v) { return std::find(group.begin(), group.end(), v) != group.end(); };
@@ -1637,6 +1638,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       // two cut nodes around u (for a node on the outer boundary, the rim: it stays on the
       // boundary's polygonal surface).
       targets.clear();
+      targetEdges.clear();
       targets.emplace_back();
       nodeDistance(u, &targets.back());
       for (const std::int32_t *s = starB(u), *sEnd = starE(u); s < sEnd; ++s) {
@@ -1646,6 +1648,11 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
           for (int j = i + 1; j < 4; ++j) {
             const int a = mesh.T(t, i), b = mesh.T(t, j);
             if (a == u || b == u || !onCut[a] || !onCut[b]) continue;
+            // The same link edge seen from its other tet, possibly as (b, a): its point differs
+            // from the first one's in rounding only, and is not tried again.
+            const std::uint64_t edge = std::uint64_t(std::uint32_t(std::min(a, b))) << 32 | std::uint32_t(std::max(a, b));
+            if (std::find(targetEdges.begin(), targetEdges.end(), edge) != targetEdges.end()) continue;
+            targetEdges.push_back(edge);
             const Vec3 pa = pos(a), ab = pos(b) - pa;
             const double l2 = ab.squaredNorm();
             if (!(l2 > 0)) continue;
