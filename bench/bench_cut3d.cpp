@@ -14,6 +14,7 @@
 // BM_Cut3DReplay: recorded shaving passes (HYSIM_REPLAY_DIR, see below).
 // BM_Cut3DSurface: the same meshes cut by a curved swept strip (the shaving passes' surfaces):
 //   ./build/bench/bench_cut3d --benchmark_filter='BM_Cut3DSurface'
+// BM_CutSurfaceBuild: building the recorded passes' surfaces, strip tree against sorted tree.
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -326,7 +327,7 @@ const std::vector<ReplayPass>& replayPasses() {
     hysim::cutting::TetMesh mesh;
     hysim::cutting::TriMesh tri;
     for (int i = 1; hysim::bench::readDumpedPass(i, mesh, tri); ++i) {
-      auto s = hysim::cutting::CutSurface::triangles(tri.X, tri.F);
+      auto s = hysim::bench::dumpedSurface(tri);
       if (!s.ok()) break;
       out.push_back({std::move(mesh), std::move(*s)});
     }
@@ -374,6 +375,49 @@ void BM_Cut3DReplay(benchmark::State& state) {
   state.counters["q_min_sum"] = qSum;
 }
 BENCHMARK(BM_Cut3DReplay)->Unit(benchmark::kMillisecond)->Iterations(3)->Repetitions(1);
+
+// Building the recorded passes' cut surfaces (the last part of the pass's map_ms): arg 0 =
+// CutSurface::strip (the simulator's, a tree along the grid), 1 = CutSurface::triangles of
+// the same triangles (centroid-sorted tree). Counter build_ms: the median over the passes.
+void BM_CutSurfaceBuild(benchmark::State& state) {
+  std::vector<hysim::cutting::TriMesh> surfaces;
+  {
+    hysim::cutting::TetMesh mesh;
+    hysim::cutting::TriMesh tri;
+    for (int i = 1; hysim::bench::readDumpedPass(i, mesh, tri); ++i) surfaces.push_back(tri);
+  }
+  if (surfaces.empty()) {
+    state.SkipWithError("HYSIM_REPLAY_DIR unset or without pass_001_mesh.msh / pass_001_surface.msh");
+    return;
+  }
+  // Each dump's strip shape (rows x row_size), as bench::dumpedSurface finds it.
+  std::vector<std::pair<int, int>> shape;
+  for (const auto& t : surfaces) {
+    shape.emplace_back(0, 0);
+    for (int row_size = 2; row_size <= t.X.rows() / 2 && shape.back().first == 0; ++row_size) {
+      const int rows = static_cast<int>(t.X.rows() / row_size);
+      if (t.X.rows() % row_size == 0 && 2 * static_cast<Eigen::Index>(rows - 1) * (row_size - 1) == t.F.rows() &&
+          hysim::cutting::CutSurface::stripTriangles(rows, row_size) == t.F)
+        shape.back() = {rows, row_size};
+    }
+    if (shape.back().first == 0) {
+      state.SkipWithError("a dumped surface is not a strip");
+      return;
+    }
+  }
+  std::vector<double> ms;
+  for (auto _ : state)
+    for (size_t i = 0; i < surfaces.size(); ++i) {
+      const auto t0 = std::chrono::steady_clock::now();
+      auto s = state.range(0) == 0 ? hysim::cutting::CutSurface::strip(surfaces[i].X, shape[i].first, shape[i].second)
+                                   : hysim::cutting::CutSurface::triangles(surfaces[i].X, surfaces[i].F);
+      ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+      benchmark::DoNotOptimize(s);
+    }
+  std::sort(ms.begin(), ms.end());
+  state.counters["build_ms"] = ms[ms.size() / 2];
+}
+BENCHMARK(BM_CutSurfaceBuild)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->Iterations(20);
 
 }  // namespace
 

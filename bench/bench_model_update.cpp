@@ -200,7 +200,7 @@ int main() {
     hysim::cutting::TetMesh mesh;
     hysim::cutting::TriMesh tri;
     for (int i = 1; hysim::bench::readDumpedPass(i, mesh, tri); ++i) {
-      auto s = hysim::cutting::CutSurface::triangles(tri.X, tri.F);
+      auto s = hysim::bench::dumpedSurface(tri);
       if (!s.ok()) break;
       Case c;
       c.name = "pass " + std::to_string(i);

@@ -128,7 +128,7 @@ const std::vector<CutPass>& cutPasses() {
     cutting::TetMesh mesh;
     cutting::TriMesh surface;
     for (int i = 1; bench::readDumpedPass(i, mesh, surface); ++i) {
-      auto s = cutting::CutSurface::triangles(surface.X, surface.F);
+      auto s = bench::dumpedSurface(surface);
       if (!s.ok()) break;
       cutting::Cut3DOptions o;
       o.method = cutting::CutMethod::Hybrid;

@@ -19,11 +19,10 @@ Result<CutSurface> CutSurface::plane(const Eigen::Vector3d& point, const Eigen::
   return s;
 }
 
-Result<CutSurface> CutSurface::triangles(const Positions& X, const Tris& F) {
-  CutSurface s;
-  s.is_plane_ = false;
+Result<std::vector<CutSurface::Tri>> CutSurface::collect(const Positions& X, const Tris& F, std::vector<int>* kept) {
   std::vector<Tri> tri;  // in input order (degenerate ones dropped)
   tri.reserve(static_cast<size_t>(F.rows()));
+  if (kept) kept->assign(static_cast<size_t>(F.rows()), -1);
   for (Eigen::Index f = 0; f < F.rows(); ++f) {
     for (int k = 0; k < 3; ++k)
       if (F(f, k) < 0 || F(f, k) >= X.rows())
@@ -38,12 +37,15 @@ Result<CutSurface> CutSurface::triangles(const Positions& X, const Tris& F) {
     const double scale = std::max({(t.b - t.a).squaredNorm(), (t.c - t.a).squaredNorm(), (t.c - t.b).squaredNorm()});
     if (!(n.norm() > 1e-12 * scale)) continue;  // degenerate
     t.n = n.normalized();
+    if (kept) (*kept)[static_cast<size_t>(f)] = static_cast<int>(tri.size());
     tri.push_back(t);
   }
   if (tri.empty()) return Error{"cut surface: no non-degenerate triangle"};
+  return tri;
+}
+
+void CutSurface::finish(const std::vector<Tri>& tri) {
   const int count = static_cast<int>(tri.size());
-  s.order_.resize(count);
-  for (int i = 0; i < count; ++i) s.order_[i] = i;
   // Per triangle, once: its box, a + b + c (the split key) and its centroid (a + b + c) / 3,
   // the same values the tree build used to recompute at every level.
   BuildScratch scratch;
@@ -59,13 +61,89 @@ Result<CutSurface> CutSurface::triangles(const Positions& X, const Tris& F) {
     scratch.sum[i] = t.a + t.b + t.c;
     scratch.centre[i] = scratch.sum[i] / 3.0;
   }
-  s.nodes_.reserve(2 * tri.size());
-  s.build(0, count, scratch);
-  s.bounds_ = s.nodes_[0].box;
+  nodes_.reserve(2 * tri.size());
+  build(0, count, scratch);
+  bounds_ = nodes_[0].box;
   // The triangles in tree order (leaf ranges contiguous), with what the segment test needs.
-  s.leafTri_.reserve(count);
+  leafTri_.reserve(count);
   for (int i = 0; i < count; ++i) {
-    const Tri& t = tri[s.order_[i]];
+    const Tri& t = tri[order_[i]];
+    leafTri_.push_back({t, t.n.dot((t.b - t.a).cross(t.c - t.a))});
+  }
+}
+
+Result<CutSurface> CutSurface::triangles(const Positions& X, const Tris& F) {
+  auto tri = collect(X, F, nullptr);
+  if (!tri.ok()) return Error{tri.error()};
+  CutSurface s;
+  s.is_plane_ = false;
+  const int count = static_cast<int>(tri->size());
+  s.order_.resize(count);
+  for (int i = 0; i < count; ++i) s.order_[i] = i;
+  s.finish(*tri);
+  return s;
+}
+
+Tris CutSurface::stripTriangles(int rows, int row_size) {
+  Tris F(2 * static_cast<Eigen::Index>(std::max(rows - 1, 0)) * std::max(row_size - 1, 0), 3);
+  for (int r = 0, f = 0; r + 1 < rows; ++r)
+    for (int i = 0; i + 1 < row_size; ++i) {
+      const int a = r * row_size + i, b = a + 1, c = a + row_size, d = c + 1;
+      F.row(f++) << a, b, d;
+      F.row(f++) << a, d, c;
+    }
+  return F;
+}
+
+Result<CutSurface> CutSurface::strip(const Positions& X, int rows, int row_size) {
+  if (rows < 2 || row_size < 2 || X.rows() != static_cast<Eigen::Index>(rows) * row_size)
+    return Error{"cut surface: a strip needs at least 2 x 2 vertices, " + std::to_string(rows) + " x " +
+                 std::to_string(row_size) + " for " + std::to_string(X.rows()) + " vertices"};
+  std::vector<int> kept;
+  auto tri = collect(X, stripTriangles(rows, row_size), &kept);
+  if (!tri.ok()) return Error{tri.error()};
+  CutSurface s;
+  s.is_plane_ = false;
+  s.order_.reserve(tri->size());
+  // The tree follows a recursive bisection of the grid across its longer side (in space,
+  // between the middles of opposite sides); a leaf holds one or two quads' kept triangles.
+  auto at = [&](int r, int i) { return Eigen::Vector3d(X.row(static_cast<Eigen::Index>(r) * row_size + i).transpose()); };
+  s.nodes_.reserve(2 * tri->size());
+  auto node = [&](auto&& self, int r0, int r1, int c0, int c1) -> int {
+    const int id = static_cast<int>(s.nodes_.size());
+    s.nodes_.emplace_back();
+    const int nr = r1 - r0, nc = c1 - c0;
+    if (nr * nc <= 2) {
+      Eigen::AlignedBox3d box;  // empty
+      s.nodes_[id].begin = static_cast<int>(s.order_.size());
+      for (int r = r0; r < r1; ++r)
+        for (int c = c0; c < c1; ++c)
+          for (int h = 0; h < 2; ++h) {
+            const int k = kept[2 * (r * (row_size - 1) + c) + h];
+            if (k < 0) continue;
+            s.order_.push_back(k);
+            const Tri& t = (*tri)[k];
+            box.extend(t.a).extend(t.b).extend(t.c);
+          }
+      s.nodes_[id].end = static_cast<int>(s.order_.size());
+      s.nodes_[id].box = box;
+      return id;
+    }
+    const int rm = (r0 + r1) / 2, cm = (c0 + c1) / 2;
+    const double along_rows = (at(r1, cm) - at(r0, cm)).norm(), along_cols = (at(rm, c1) - at(rm, c0)).norm();
+    const bool split_rows = nc == 1 || (nr > 1 && along_rows >= along_cols);
+    const int left = split_rows ? self(self, r0, rm, c0, c1) : self(self, r0, r1, c0, cm);
+    const int right = split_rows ? self(self, rm, r1, c0, c1) : self(self, r0, r1, cm, c1);
+    s.nodes_[id].left = left;
+    s.nodes_[id].right = right;
+    s.nodes_[id].box = s.nodes_[left].box.merged(s.nodes_[right].box);
+    return id;
+  };
+  node(node, 0, rows - 1, 0, row_size - 1);
+  s.bounds_ = s.nodes_[0].box;
+  s.leafTri_.reserve(tri->size());
+  for (int k : s.order_) {
+    const Tri& t = (*tri)[k];
     s.leafTri_.push_back({t, t.n.dot((t.b - t.a).cross(t.c - t.a))});
   }
   return s;

@@ -633,19 +633,13 @@ void Simulation::finishPass() {
   const int kept = static_cast<int>(rest_rows_.size()) / row_size;
   cutting::Positions rv(static_cast<Eigen::Index>(kept) * row_size, 3);
   for (Eigen::Index i = 0; i < rv.rows(); ++i) rv.row(i) = rest_rows_[static_cast<size_t>(i)].transpose();
-  cutting::Tris rf(static_cast<Eigen::Index>(2 * (kept - 1) * (row_size - 1)), 3);
-  for (int r = 0, f = 0; r + 1 < kept; ++r)
-    for (int i = 0; i + 1 < row_size; ++i) {
-      const int a0 = r * row_size + i, b0 = a0 + 1, c0 = a0 + row_size, d0 = c0 + 1;
-      rf.row(f++) << a0, b0, d0;
-      rf.row(f++) << a0, d0, c0;
-    }
-  auto surface = cutting::CutSurface::triangles(rv, rf);
+  auto surface = cutting::CutSurface::strip(rv, kept, row_size);
   if (!surface.ok()) return fail(surface.error());
   timer.lap(&rec.map_ms);
   if (!cut_dump_dir_.empty()) {  // debugging (setCutDumpDir): the cut's input, to repeat offline
     char name[64];
     std::snprintf(name, sizeof(name), "/pass_%03d_", static_cast<int>(passes_.size()) + 1);
+    const cutting::Tris rf = cutting::CutSurface::stripTriangles(kept, row_size);
     const cutting::TriMesh sweep_mesh{rv, rf, cutting::Labels::Zero(rf.rows())};
     Status st = cutting::writeMesh(cut_dump_dir_ + name + "mesh.msh", mesh_);
     if (st.ok()) st = cutting::writeMesh(cut_dump_dir_ + name + "surface.msh", sweep_mesh);

@@ -530,6 +530,64 @@ TEST(Cut3D, BadInput) {
   EXPECT_FALSE(cut3d(bad, *CutSurface::plane(Vec3(0, 0, 0), Vec3(0, 0, 1))).ok());
 }
 
+// CutSurface::strip is the surface triangles() makes of the same grid (same triangle
+// numbers), only with a tree that follows the grid: every query answers the same, bit for
+// bit, and cut3d cuts the same. The strip: a half-cylinder loop swept along a bent path,
+// with a collapsed quad (degenerate triangles, dropped by both).
+TEST(Cut3D, StripIsTheSameSurfaceAsItsTriangles) {
+  const int rows = 23, row_size = 13;
+  Positions X(rows * row_size, 3);
+  for (int r = 0; r < rows; ++r)
+    for (int i = 0; i < row_size; ++i) {
+      const double a = M_PI + M_PI * i / (row_size - 1), z = 1.2 * r / (rows - 1) - 0.1;
+      X.row(r * row_size + i) << 0.5 + 0.4 * std::cos(a) + 0.3 * z * z, 0.9 + 0.4 * std::sin(a) + 0.1 * z, z;
+    }
+  X.row(5 * row_size + 4) = X.row(5 * row_size + 3);  // quad (5, 3) collapses to a triangle's edge
+  X.row(6 * row_size + 4) = X.row(6 * row_size + 3);
+  const Tris F = CutSurface::stripTriangles(rows, row_size);
+  ASSERT_EQ(F.rows(), 2 * (rows - 1) * (row_size - 1));
+  const auto sorted = CutSurface::triangles(X, F);
+  const auto grid = CutSurface::strip(X, rows, row_size);
+  ASSERT_TRUE(sorted.ok() && grid.ok());
+  EXPECT_EQ(grid->numTriangles(), sorted->numTriangles());
+  // Dropped: quad (5, 3)'s two triangles, and one each of quads (4, 3) and (6, 3).
+  EXPECT_EQ(grid->numTriangles(), 2 * (rows - 1) * (row_size - 1) - 4);
+  EXPECT_EQ(grid->bounds().min(), sorted->bounds().min());
+  EXPECT_EQ(grid->bounds().max(), sorted->bounds().max());
+  const double eps = 1e-9;
+  int hits = 0;
+  for (int i = 0; i < 800; ++i) {
+    const Vec3 x = pointAroundStrip(i);
+    Vec3 p, q;
+    EXPECT_EQ(grid->signedDistance(x, &p), sorted->signedDistance(x, &q)) << x.transpose();
+    EXPECT_EQ(p, q);
+    EXPECT_EQ(grid->signedDistanceNear(x, 0.2, &p), sorted->signedDistanceNear(x, 0.2, &q));
+    EXPECT_EQ(p, q);
+    for (double r : {1e-3, 0.05, 0.3}) EXPECT_EQ(grid->within(x, r), sorted->within(x, r));
+    const Vec3 b = pointAroundStrip(i + 7919);
+    CutSurface::Hit h1, h2;
+    const bool f1 = grid->intersectSegment(x, b, eps, &h1), f2 = sorted->intersectSegment(x, b, eps, &h2);
+    EXPECT_EQ(f1, f2) << x.transpose() << " / " << b.transpose();
+    if (f1 && f2) {
+      EXPECT_EQ(h1.t, h2.t);
+      EXPECT_EQ(h1.normal, h2.normal);
+    }
+    hits += f1;
+  }
+  EXPECT_GT(hits, 100);
+  // The same cut of a block of tets.
+  const TetMesh block = testing::boxTetMesh(4, 4, 4, 0.25);
+  const auto c1 = cut3d(block, *grid), c2 = cut3d(block, *sorted);
+  ASSERT_TRUE(c1.ok() && c2.ok());
+  EXPECT_EQ(c1->mesh.X, c2->mesh.X);
+  EXPECT_EQ(c1->mesh.T, c2->mesh.T);
+  EXPECT_GT(c1->report.crossed_edges, 0);
+  // Bad shapes: too few rows or columns, or vertices that do not make rows x row_size.
+  EXPECT_FALSE(CutSurface::strip(X, 1, rows * row_size).ok());
+  EXPECT_FALSE(CutSurface::strip(X, rows, 1).ok());
+  EXPECT_FALSE(CutSurface::strip(X, rows - 1, row_size).ok());
+}
+
 TEST(Cut3D, ComponentsFreeAndVolumes) {
   const TetMesh box = testing::boxTetMesh(2, 2, 2, 1.0);
   const auto r = cutAndCheck(box, Vec3(0, 0, 1), Vec3(0, 0, 1), withMethod(CutMethod::Hybrid));

@@ -30,6 +30,16 @@ class CutSurface {
   // Open (or closed) triangle surface; degenerate triangles are dropped. Errors: no usable
   // triangle, indices out of range, non-finite coordinates.
   static Result<CutSurface> triangles(const Positions& X, const Tris& F);
+  // A strip: `rows` rows of `row_size` vertices (X row-major, rows * row_size rows), two
+  // triangles per quad as stripTriangles gives them. The same surface as
+  // triangles(X, stripTriangles(rows, row_size)), triangle numbers included, so the queries
+  // give the same answers (ties go to the lower number whatever the tree); its tree follows
+  // the grid (bisected across its longer side, one or two quads per leaf) instead of sorting
+  // centroids: cheaper to build, and tighter boxes for a swept loop.
+  static Result<CutSurface> strip(const Positions& X, int rows, int row_size);
+  // The strip's triangles: for row r and column i, (a, a + 1, a + row_size + 1) and
+  // (a, a + row_size + 1, a + row_size) with a = r * row_size + i, row by row.
+  static Tris stripTriangles(int rows, int row_size);
 
   bool isPlane() const { return is_plane_; }
   const Eigen::Vector3d& planePoint() const { return point_; }
@@ -81,6 +91,12 @@ class CutSurface {
     std::vector<Eigen::Vector3d> lo, hi, sum, centre;  // per triangle: box, a + b + c, centroid
     std::vector<std::pair<double, int>> keyed;         // the split's (key, triangle) pairs
   };
+  // Tri records of F's non-degenerate triangles in input order (`kept`: F's row -> index
+  // there, -1 when dropped), or an error.
+  static Result<std::vector<Tri>> collect(const Positions& X, const Tris& F, std::vector<int>* kept);
+  // The centroid-sorted tree over the triangles (order_ preset to input order) and the leaf
+  // triangles.
+  void finish(const std::vector<Tri>& tri);
   int build(int begin, int end, BuildScratch& scratch);
 
   bool is_plane_ = true;
