@@ -519,89 +519,97 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   // goes away (compacted), which is fine.
   // linkOnly: only fill `link` (the boundary edges around v, up to the first face used by
   // more than two tets) and return whether the faces are; the loop check is skipped.
-  std::vector<std::int32_t> linkDeg, linkInc, tetLocal;
+  std::vector<std::int32_t> linkDeg, linkInc, tetLocal, faceKey, linkLocal;
   std::vector<std::uint16_t> faceUses;
   auto discAround = [&](int v, const std::vector<std::int32_t>& around, bool linkOnly = false) {
     link.clear();
     if (around.empty()) return true;
     // Every tet of `around` has v; a face (v, a, b) is used by the tets with both a and b:
     // count the pairs of each tet's other three nodes in a table over v's neighbours.
-    // Each tet's nodes as local numbers (-1: v), read from the mesh once.
+    // Each tet's three other nodes as local numbers (in the tet's order), read from the mesh
+    // once.
     nbrs.clear();
-    tetLocal.resize(4 * around.size());
-    for (size_t i = 0; i < around.size(); ++i)
+    const size_t n = around.size();
+    tetLocal.resize(3 * n);
+    for (size_t i = 0; i < n; ++i) {
+      const int t = around[i];
+      std::int32_t* o = &tetLocal[3 * i];
+      int m = 0;
       for (int k = 0; k < 4; ++k) {
-        const int w = mesh.T(around[i], k);
-        if (w == v) {
-          tetLocal[4 * i + k] = -1;
-          continue;
-        }
-        if (localId[w] < 0) {
-          localId[w] = static_cast<std::int32_t>(nbrs.size());
+        const int w = mesh.T(t, k);
+        if (w == v) continue;
+        std::int32_t& id = localId[w];
+        if (id < 0) {
+          id = static_cast<std::int32_t>(nbrs.size());
           nbrs.push_back(w);
         }
-        tetLocal[4 * i + k] = localId[w];
+        if (m < 3) o[m++] = id;
       }
-    const size_t L = nbrs.size();
-    faceUses.assign(L * L, 0);
-    for (size_t i = 0; i < around.size(); ++i) {
-      std::int32_t o[3], m = 0;
-      for (int k = 0; k < 4; ++k)
-        if (tetLocal[4 * i + k] >= 0 && m < 3) o[m++] = tetLocal[4 * i + k];
-      for (int a = 0; a < m; ++a)
-        for (int b = a + 1; b < m; ++b) ++faceUses[std::min(o[a], o[b]) * L + std::max(o[a], o[b])];
     }
+    // The faces at v of each tet, in the order of the face opposite each other node (faces
+    // f != v's in order f = 0..3: without o[0], without o[1], without o[2]): the pairs
+    // (o1, o2), (o0, o2), (o0, o1), each as its table index min * L + max.
+    const std::int32_t L = static_cast<std::int32_t>(nbrs.size());
+    faceUses.assign(static_cast<size_t>(L) * L, 0);
+    faceKey.resize(3 * n);
+    for (size_t i = 0; i < n; ++i) {
+      const std::int32_t* o = &tetLocal[3 * i];
+      std::int32_t* key = &faceKey[3 * i];
+      const std::int32_t a = o[0], b = o[1], c = o[2];
+      key[0] = std::min(b, c) * L + std::max(b, c);
+      key[1] = std::min(a, c) * L + std::max(a, c);
+      key[2] = std::min(a, b) * L + std::max(a, b);
+      ++faceUses[key[0]];
+      ++faceUses[key[1]];
+      ++faceUses[key[2]];
+    }
+    // The boundary faces' edges (as global and local numbers), up to the first face used by
+    // more than two tets.
     bool manifold = true;
-    for (size_t i = 0; i < around.size() && manifold; ++i) {
-      const std::int32_t* tl = &tetLocal[4 * i];
-      int lv = 0;
-      while (tl[lv] >= 0) ++lv;
-      // The faces f != lv in order; face f at v: the two nodes other than f and lv.
-      for (int f = 0; f < 4; ++f) {
-        if (f == lv) continue;
-        std::int32_t o[2], m = 0;
-        for (int k = 0; k < 4; ++k)
-          if (k != f && k != lv) o[m++] = tl[k];
-        const std::uint16_t uses = faceUses[std::min(o[0], o[1]) * L + std::max(o[0], o[1])];
+    linkLocal.clear();
+    for (size_t i = 0; i < n && manifold; ++i) {
+      const std::int32_t* o = &tetLocal[3 * i];
+      const std::int32_t* key = &faceKey[3 * i];
+      for (int f = 0; f < 3; ++f) {
+        const std::uint16_t uses = faceUses[key[f]];
         if (uses > 2) {
           manifold = false;
           break;
         }
         if (uses == 1) {
-          link.push_back(nbrs[o[0]]);
-          link.push_back(nbrs[o[1]]);
+          const std::int32_t p = f == 0 ? o[1] : o[0], q = f == 2 ? o[1] : o[2];
+          link.push_back(nbrs[p]);
+          link.push_back(nbrs[q]);
+          linkLocal.push_back(p);
+          linkLocal.push_back(q);
         }
       }
     }
-    if (!manifold || link.empty() || linkOnly) {
-      for (int w : nbrs) localId[w] = -1;
-      return manifold;  // (link.empty(): an interior node)
-    }
+    for (int w : nbrs) localId[w] = -1;
+    if (!manifold || link.empty() || linkOnly) return manifold;  // (link.empty(): an interior node)
     // One closed loop: every link vertex has degree 2, and walking from one edge visits all.
     // Each link vertex's (first two) edges in a table over v's neighbours: with all degrees 2
     // the walk from edge 0 leaves each vertex by its other edge, and it visits all edges iff
-    // they form one loop.
-    const size_t edges = link.size() / 2;
+    // they form one loop. (On the local numbers: the same walk.)
+    const size_t edges = linkLocal.size() / 2;
     linkDeg.assign(L, 0);
-    linkInc.resize(2 * L);
-    for (size_t i = 0; i < link.size(); ++i) {
-      const std::int32_t id = localId[link[i]];
+    linkInc.resize(2 * static_cast<size_t>(L));
+    for (size_t i = 0; i < linkLocal.size(); ++i) {
+      const std::int32_t id = linkLocal[i];
       if (linkDeg[id] < 2) linkInc[2 * id + linkDeg[id]] = static_cast<std::int32_t>(i / 2);
       ++linkDeg[id];
     }
     bool loop = true;
-    for (size_t i = 0; i < link.size() && loop; ++i) loop = linkDeg[localId[link[i]]] == 2;
+    for (size_t i = 0; i < linkLocal.size() && loop; ++i) loop = linkDeg[linkLocal[i]] == 2;
     size_t visited = 1;
-    std::int32_t start = link[0], at = link[1];
+    std::int32_t start = linkLocal[0], at = linkLocal[1];
     std::int32_t prevEdge = 0;
     while (loop && at != start && visited <= edges) {
-      const std::int32_t id = localId[at];
-      const std::int32_t next = linkInc[2 * id] != prevEdge ? linkInc[2 * id] : linkInc[2 * id + 1];
-      at = link[2 * next] == at ? link[2 * next + 1] : link[2 * next];
+      const std::int32_t next = linkInc[2 * at] != prevEdge ? linkInc[2 * at] : linkInc[2 * at + 1];
+      at = linkLocal[2 * next] == at ? linkLocal[2 * next + 1] : linkLocal[2 * next];
       prevEdge = next;
       ++visited;
     }
-    for (int w : nbrs) localId[w] = -1;
     return loop && at == start && visited == edges;
   };
   std::vector<std::int32_t> around;
