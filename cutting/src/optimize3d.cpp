@@ -1051,6 +1051,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     if (!(options.collapse_fraction > 0)) return;
     std::vector<std::uint8_t> locked(N, 0);
     std::vector<std::int32_t> dying, changing, vstar, checked;
+    std::vector<double> detAfter;  // per changing tet: 6 x its volume after the collapse
     std::vector<std::array<std::int32_t, 4>> keysB;
     struct Cand {
       double len;
@@ -1162,37 +1163,69 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       for (const Cand& c : cands) {
         const int u = c.u, v = c.v;
         if (locked[u] || locked[v]) continue;
+        // One pass over u's live tets: those with v die, the others change (u becomes v).
+        // Checks in order of cost, all must pass and have no side effects (so the first
+        // failure rejects, whichever it is): off the cut, one material (every live tet of u,
+        // that is the dying and changing ones, has the label of the first); no changed tet
+        // inverts or goes flat (its determinant with v for u, in tetVolumeHere's scalar
+        // arithmetic: Eigen's (p1 - p0).dot((p2 - p0).cross(p3 - p0)), the same value; kept
+        // for the volume check below); the edge is still an edge (a tet dies).
         dying.clear();
         changing.clear();
-        for (const std::int32_t *s = starB(u), *sEnd = starE(u); s < sEnd; ++s) {
-          const int t = (*s);
-          if ((*dead)[t]) continue;
-          bool hasV = false;
-          for (int k = 0; k < 4; ++k) hasV = hasV || mesh.T(t, k) == v;
-          (hasV ? dying : changing).push_back(t);
-        }
-        if (dying.empty()) continue;  // not an edge any more
-        if (c.offCut) {
-          // Off the cut: within one material (the boundary check, which costs more, comes
-          // after the geometric ones; all checks must pass and have no side effects).
-          bool oneMaterial = true;
-          for (int t : dying) oneMaterial = oneMaterial && mesh.material(t) == mesh.material(dying[0]);
-          for (int t : changing) oneMaterial = oneMaterial && mesh.material(t) == mesh.material(dying[0]);
-          if (!oneMaterial) continue;
-        }
-        // Checks in order of cost (all must pass): no changed tet inverts or goes flat, the
-        // volume changes within the limits, the worst q* rises (short edges: does not fall).
+        detAfter.clear();
         bool ok = true;
-        const Vec3 xv = pos(v);
-        for (int t : changing) {
-          Vec3 p[4];
-          for (int k = 0; k < 4; ++k) p[k] = mesh.T(t, k) == u ? xv : pos(mesh.T(t, k));
-          if (!((p[1] - p[0]).dot((p[2] - p[0]).cross(p[3] - p[0])) > 0)) {
-            ok = false;
-            break;
+        {
+          const double* cx = mesh.X.col(0).data();
+          const double* cy = mesh.X.col(1).data();
+          const double* cz = mesh.X.col(2).data();
+          const double vx = cx[v], vy = cy[v], vz = cz[v];
+          std::int32_t mat0 = 0;
+          bool first = true;
+          for (const std::int32_t *s = starB(u), *sEnd = starE(u); s < sEnd; ++s) {
+            const int t = (*s);
+            if ((*dead)[t]) continue;
+            if (c.offCut) {
+              const std::int32_t m = mesh.material(t);
+              if (first) {
+                mat0 = m;
+                first = false;
+              } else if (m != mat0) {
+                ok = false;
+                break;
+              }
+            }
+            const int i0 = mesh.T(t, 0), i1 = mesh.T(t, 1), i2 = mesh.T(t, 2), i3 = mesh.T(t, 3);
+            if ((i0 == v) | (i1 == v) | (i2 == v) | (i3 == v)) {
+              dying.push_back(t);
+              continue;
+            }
+            const double x0 = i0 == u ? vx : cx[i0], y0 = i0 == u ? vy : cy[i0], z0 = i0 == u ? vz : cz[i0];
+            const double x1 = i1 == u ? vx : cx[i1], y1 = i1 == u ? vy : cy[i1], z1 = i1 == u ? vz : cz[i1];
+            const double x2 = i2 == u ? vx : cx[i2], y2 = i2 == u ? vy : cy[i2], z2 = i2 == u ? vz : cz[i2];
+            const double x3 = i3 == u ? vx : cx[i3], y3 = i3 == u ? vy : cy[i3], z3 = i3 == u ? vz : cz[i3];
+            const double ax = x1 - x0, ay = y1 - y0, az = z1 - z0;
+            const double bx = x2 - x0, by = y2 - y0, bz = z2 - z0;
+            const double ex = x3 - x0, ey = y3 - y0, ez = z3 - z0;
+            const double nx = by * ez - bz * ey, ny = bz * ex - bx * ez, nz = bx * ey - by * ex;
+            const double det = (ax * nx + ay * ny) + az * nz;
+#ifdef HYSIM_CHECK_EXACT
+            {
+              Vec3 p[4];
+              for (int k = 0; k < 4; ++k) p[k] = mesh.T(t, k) == u ? pos(v) : pos(mesh.T(t, k));
+              const double ref = (p[1] - p[0]).dot((p[2] - p[0]).cross(p[3] - p[0]));
+              if (std::memcmp(&ref, &det, sizeof det) != 0) std::abort();
+            }
+#endif
+            if (!(det > 0)) {
+              ok = false;
+              break;
+            }
+            changing.push_back(t);
+            detAfter.push_back(det);
           }
         }
-        if (!ok) continue;
+        if (!ok || dying.empty()) continue;
+        const Vec3 xv = pos(v);
         // Volume: the removed tets and the change of the others, against u's star.
         double before = 0, after = 0;
         matVol.clear();
@@ -1201,12 +1234,11 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
           before += vt;
           matAdd(t, vt, 0.0);
         }
-        for (int t : changing) {
+        for (size_t i = 0; i < changing.size(); ++i) {
+          const int t = changing[i];
           const double vt = tetVolumeHere(mesh, t);
           before += vt;
-          Vec3 p[4];
-          for (int k = 0; k < 4; ++k) p[k] = mesh.T(t, k) == u ? pos(v) : pos(mesh.T(t, k));
-          const double vol = (p[1] - p[0]).dot((p[2] - p[0]).cross(p[3] - p[0])) / 6.0;
+          const double vol = detAfter[i] / 6.0;
           after += vol;
           matAdd(t, vt, vol);
         }
