@@ -33,6 +33,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <iterator>
 #include <limits>
 #include <vector>
 
@@ -1109,10 +1110,13 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     // Sorted by length (then ends); an edge comes once per poor tet around it: one candidate
     // per (u, v), short if any of its copies is (a short edge's test accepts what the other
     // accepts, and copies would be tried one after the other on the same mesh).
-    auto sortMerge = [](std::vector<Cand>& c) {
-      std::sort(c.begin(), c.end(), [](const Cand& p, const Cand& q) {
-        return p.len != q.len ? p.len < q.len : p.u != q.u ? p.u < q.u : p.v < q.v;
-      });
+    auto byKey = [](const Cand& p, const Cand& q) {
+      return p.len != q.len ? p.len < q.len : p.u != q.u ? p.u < q.u : p.v < q.v;
+    };
+    // (c sorted by byKey: copies of a candidate are neighbours, in any order; the first
+    // copy's fields are kept, the same for every copy but the tet, which the loop below does
+    // not read.)
+    auto mergeCopies = [](std::vector<Cand>& c) {
       size_t kept = 0;
       for (size_t i = 0; i < c.size(); ++i) {
         if (kept > 0 && c[kept - 1].len == c[i].len && c[kept - 1].u == c[i].u && c[kept - 1].v == c[i].v) {
@@ -1123,17 +1127,29 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       }
       c.resize(kept);
     };
+#ifdef HYSIM_CHECK_EXACT
+    auto sortMerge = [&](std::vector<Cand>& c) {
+      std::sort(c.begin(), c.end(), byKey);
+      mergeCopies(c);
+    };
+#endif
+    // `raw` is kept sorted by byKey: the first batch sorts it; a later batch drops the
+    // candidates of the changed tets (the rest stays sorted), sorts the new ones and merges
+    // the two runs. The list is then the same as a sort of the whole (the same elements; copies
+    // only differ in their tet).
     for (int batch = 0; batch < 3; ++batch) {
       if (batch == 0) {
         std::vector<std::int32_t> seen;
         regionTets(seen);
         raw.clear();
         for (int t : seen) candidatesOf(t, raw);
+        std::sort(raw.begin(), raw.end(), byKey);
       } else {
         for (int t : changedTets) tetChanged[t] = 1;
         raw.erase(std::remove_if(raw.begin(), raw.end(),
                                  [&](const Cand& c) { return (*dead)[c.tet] || tetChanged[c.tet]; }),
                   raw.end());
+        const size_t kept = raw.size();
         for (int t : changedTets) {
           if (!tetChanged[t]) continue;  // (a tet changed twice: once)
           tetChanged[t] = 0;
@@ -1142,9 +1158,14 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
           if (inRegion) candidatesOf(t, raw);
         }
         changedTets.clear();
+        const auto mid = raw.begin() + static_cast<std::ptrdiff_t>(kept);
+        std::sort(mid, raw.end(), byKey);
+        cands.clear();
+        std::merge(raw.begin(), mid, mid, raw.end(), std::back_inserter(cands), byKey);
+        raw.swap(cands);
       }
       cands.assign(raw.begin(), raw.end());
-      sortMerge(cands);
+      mergeCopies(cands);
 #ifdef HYSIM_CHECK_EXACT
       {  // the same list as from scratch
         std::vector<std::int32_t> seen;
