@@ -489,7 +489,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   // Peeling: a sliver (q* below peel_quality) with a face on the boundary is removed when
   // the mesh stays manifold: the boundary faces around each of its nodes still form one
   // closed loop (a disc), or the node had no other tet (it goes with the sliver). Its volume (tiny: it is flat) is lost.
-  std::vector<std::int32_t> link;  // scratch: link edges of a node, as pairs
+  std::vector<std::int32_t> link;  // scratch: link edges of a node, as pairs (discAround's local numbers)
   auto boundaryFaceCount = [&](int t) {
     int count = 0;
     for (int f = 0; f < 4; ++f) {
@@ -520,7 +520,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   // goes away (compacted), which is fine.
   // linkOnly: only fill `link` (the boundary edges around v, up to the first face used by
   // more than two tets) and return whether the faces are; the loop check is skipped.
-  std::vector<std::int32_t> linkDeg, linkInc, tetLocal, faceKey, linkLocal;
+  std::vector<std::int32_t> linkDeg, linkInc, tetLocal, faceKey;
   std::vector<std::uint16_t> faceUses;
   auto discAround = [&](int v, const std::vector<std::int32_t>& around, bool linkOnly = false) {
     link.clear();
@@ -531,7 +531,8 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     // once.
     nbrs.clear();
     const size_t n = around.size();
-    tetLocal.resize(3 * n);
+    tetLocal.resize(3 * n + 1);  // (+1: a tet without v writes a fourth number)
+    bool threeEach = true;       // (every tet has v once: its three other nodes)
     for (size_t i = 0; i < n; ++i) {
       const int t = around[i];
       std::int32_t* o = &tetLocal[3 * i];
@@ -544,8 +545,13 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
           id = static_cast<std::int32_t>(nbrs.size());
           nbrs.push_back(w);
         }
-        if (m < 3) o[m++] = id;
+        o[m++] = id;
       }
+      threeEach = threeEach && m == 3;
+    }
+    if (!threeEach) {  // not a star of v (never so here)
+      for (int w : nbrs) localId[w] = -1;
+      return false;
     }
     // The faces at v of each tet, in the order of the face opposite each other node (faces
     // f != v's in order f = 0..3: without o[0], without o[1], without o[2]): the pairs
@@ -564,10 +570,8 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       ++faceUses[key[1]];
       ++faceUses[key[2]];
     }
-    // The boundary faces' edges (as global and local numbers), up to the first face used by
-    // more than two tets.
+    // The boundary faces' edges, up to the first face used by more than two tets.
     bool manifold = true;
-    linkLocal.clear();
     for (size_t i = 0; i < n && manifold; ++i) {
       const std::int32_t* o = &tetLocal[3 * i];
       const std::int32_t* key = &faceKey[3 * i];
@@ -579,10 +583,8 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
         }
         if (uses == 1) {
           const std::int32_t p = f == 0 ? o[1] : o[0], q = f == 2 ? o[1] : o[2];
-          link.push_back(nbrs[p]);
-          link.push_back(nbrs[q]);
-          linkLocal.push_back(p);
-          linkLocal.push_back(q);
+          link.push_back(p);
+          link.push_back(q);
         }
       }
     }
@@ -591,23 +593,23 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     // One closed loop: every link vertex has degree 2, and walking from one edge visits all.
     // Each link vertex's (first two) edges in a table over v's neighbours: with all degrees 2
     // the walk from edge 0 leaves each vertex by its other edge, and it visits all edges iff
-    // they form one loop. (On the local numbers: the same walk.)
-    const size_t edges = linkLocal.size() / 2;
+    // they form one loop.
+    const size_t edges = link.size() / 2;
     linkDeg.assign(L, 0);
     linkInc.resize(2 * static_cast<size_t>(L));
-    for (size_t i = 0; i < linkLocal.size(); ++i) {
-      const std::int32_t id = linkLocal[i];
+    for (size_t i = 0; i < link.size(); ++i) {
+      const std::int32_t id = link[i];
       if (linkDeg[id] < 2) linkInc[2 * id + linkDeg[id]] = static_cast<std::int32_t>(i / 2);
       ++linkDeg[id];
     }
     bool loop = true;
-    for (size_t i = 0; i < linkLocal.size() && loop; ++i) loop = linkDeg[linkLocal[i]] == 2;
+    for (size_t i = 0; i < link.size() && loop; ++i) loop = linkDeg[link[i]] == 2;
     size_t visited = 1;
-    std::int32_t start = linkLocal[0], at = linkLocal[1];
+    std::int32_t start = link[0], at = link[1];
     std::int32_t prevEdge = 0;
     while (loop && at != start && visited <= edges) {
       const std::int32_t next = linkInc[2 * at] != prevEdge ? linkInc[2 * at] : linkInc[2 * at + 1];
-      at = linkLocal[2 * next] == at ? linkLocal[2 * next + 1] : linkLocal[2 * next];
+      at = link[2 * next] == at ? link[2 * next + 1] : link[2 * next];
       prevEdge = next;
       ++visited;
     }
