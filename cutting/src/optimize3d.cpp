@@ -1082,6 +1082,17 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
             lens[e] = (pos(mesh.T(t, a)) - pos(mesh.T(t, b))).norm();
             mean += lens[e] / 6.0;
           }
+        // A tet at or above quality_target has only its short edges: none where the shortest
+        // is not below collapse_fraction x the longest (a bound on the mean: the six rounded
+        // sixths add up to at most hi (1 + 6 eps) < hi (1 + 1e-9)) or the local edge.
+        if (q >= options.quality_target) {
+          double lo = lens[0], hi = lens[0];
+          for (int e = 1; e < 6; ++e) {
+            lo = std::min(lo, lens[e]);
+            hi = std::max(hi, lens[e]);
+          }
+          if (lo >= options.collapse_fraction * std::max(hi * (1 + 1e-9), region.edge_length)) return;
+        }
         for (int a = 0, e = 0; a < 4; ++a)
           for (int b = a + 1; b < 4; ++b, ++e) {
             const int x = mesh.T(t, a), y = mesh.T(t, b);
