@@ -1129,21 +1129,24 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     // (c sorted by byKey: copies of a candidate are neighbours, in any order; the first
     // copy's fields are kept, the same for every copy but the tet, which the loop below does
     // not read.)
-    auto mergeCopies = [](std::vector<Cand>& c) {
+    // (Into `out`, which is resized to c's size first and then cut to the merged count.)
+    auto mergeCopies = [](const std::vector<Cand>& c, std::vector<Cand>& out) {
+      out.resize(c.size());
       size_t kept = 0;
       for (size_t i = 0; i < c.size(); ++i) {
-        if (kept > 0 && c[kept - 1].len == c[i].len && c[kept - 1].u == c[i].u && c[kept - 1].v == c[i].v) {
-          c[kept - 1].shortEdge = c[kept - 1].shortEdge || c[i].shortEdge;
+        if (kept > 0 && out[kept - 1].len == c[i].len && out[kept - 1].u == c[i].u && out[kept - 1].v == c[i].v) {
+          out[kept - 1].shortEdge = out[kept - 1].shortEdge || c[i].shortEdge;
           continue;
         }
-        c[kept++] = c[i];
+        out[kept++] = c[i];
       }
-      c.resize(kept);
+      out.resize(kept);
     };
 #ifdef HYSIM_CHECK_EXACT
     auto sortMerge = [&](std::vector<Cand>& c) {
       std::sort(c.begin(), c.end(), byKey);
-      mergeCopies(c);
+      const std::vector<Cand> all = c;
+      mergeCopies(all, c);
     };
 #endif
     // `raw` is kept sorted by byKey: the first batch sorts it; a later batch drops the
@@ -1177,8 +1180,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
         std::merge(raw.begin(), mid, mid, raw.end(), std::back_inserter(cands), byKey);
         raw.swap(cands);
       }
-      cands.assign(raw.begin(), raw.end());
-      mergeCopies(cands);
+      mergeCopies(raw, cands);
 #ifdef HYSIM_CHECK_EXACT
       {  // the same list as from scratch
         std::vector<std::int32_t> seen;
