@@ -1077,9 +1077,10 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
         const double q = tetQ(t);
         if (lastResort && !(q < options.flap_quality)) return;
         double mean = 0, lens[6];
+        const Vec3 p[4] = {pos(mesh.T(t, 0)), pos(mesh.T(t, 1)), pos(mesh.T(t, 2)), pos(mesh.T(t, 3))};
         for (int a = 0, e = 0; a < 4; ++a)
           for (int b = a + 1; b < 4; ++b, ++e) {
-            lens[e] = (pos(mesh.T(t, a)) - pos(mesh.T(t, b))).norm();
+            lens[e] = (p[a] - p[b]).norm();
             mean += lens[e] / 6.0;
           }
         // A tet at or above quality_target has only its short edges: none where the shortest
