@@ -33,6 +33,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <functional>
 #include <iterator>
 #include <limits>
 #include <vector>
@@ -163,9 +164,16 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     for (int n : touchedList) {
       scratch.assign(starB(n), starE(n));
       auto g = std::lower_bound(gained.begin(), gained.end(), std::make_pair(static_cast<std::int32_t>(n), std::int32_t{-1}));
-      for (; g != gained.end() && g->first == n; ++g) scratch.push_back(g->second);
-      std::sort(scratch.begin(), scratch.end());
-      scratch.erase(std::unique(scratch.begin(), scratch.end()), scratch.end());
+      // (A list is sorted and without repeats: a node that gained no tet needs no sort.)
+      if (g != gained.end() && g->first == n) {
+        for (; g != gained.end() && g->first == n; ++g) scratch.push_back(g->second);
+        std::sort(scratch.begin(), scratch.end());
+        scratch.erase(std::unique(scratch.begin(), scratch.end()), scratch.end());
+      }
+#ifdef HYSIM_CHECK_EXACT
+      if (std::adjacent_find(scratch.begin(), scratch.end(), std::greater_equal<std::int32_t>()) != scratch.end())
+        std::abort();
+#endif
       ovrStart[n] = static_cast<std::int32_t>(ovrPool.size());
       for (int t : scratch) {
         if ((*dead)[t]) continue;
