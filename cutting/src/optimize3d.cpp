@@ -33,6 +33,8 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <functional>
+#include <iterator>
 #include <limits>
 #include <vector>
 
@@ -162,9 +164,16 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     for (int n : touchedList) {
       scratch.assign(starB(n), starE(n));
       auto g = std::lower_bound(gained.begin(), gained.end(), std::make_pair(static_cast<std::int32_t>(n), std::int32_t{-1}));
-      for (; g != gained.end() && g->first == n; ++g) scratch.push_back(g->second);
-      std::sort(scratch.begin(), scratch.end());
-      scratch.erase(std::unique(scratch.begin(), scratch.end()), scratch.end());
+      // (A list is sorted and without repeats: a node that gained no tet needs no sort.)
+      if (g != gained.end() && g->first == n) {
+        for (; g != gained.end() && g->first == n; ++g) scratch.push_back(g->second);
+        std::sort(scratch.begin(), scratch.end());
+        scratch.erase(std::unique(scratch.begin(), scratch.end()), scratch.end());
+      }
+#ifdef HYSIM_CHECK_EXACT
+      if (std::adjacent_find(scratch.begin(), scratch.end(), std::greater_equal<std::int32_t>()) != scratch.end())
+        std::abort();
+#endif
       ovrStart[n] = static_cast<std::int32_t>(ovrPool.size());
       for (int t : scratch) {
         if ((*dead)[t]) continue;
@@ -513,7 +522,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   // Peeling: a sliver (q* below peel_quality) with a face on the boundary is removed when
   // the mesh stays manifold: the boundary faces around each of its nodes still form one
   // closed loop (a disc), or the node had no other tet (it goes with the sliver). Its volume (tiny: it is flat) is lost.
-  std::vector<std::int32_t> link;  // scratch: link edges of a node, as pairs
+  std::vector<std::int32_t> link;  // scratch: link edges of a node, as pairs (discAround's local numbers)
   auto boundaryFaceCount = [&](int t) {
     int count = 0;
     for (int f = 0; f < 4; ++f) {
@@ -544,89 +553,99 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   // goes away (compacted), which is fine.
   // linkOnly: only fill `link` (the boundary edges around v, up to the first face used by
   // more than two tets) and return whether the faces are; the loop check is skipped.
-  std::vector<std::int32_t> linkDeg, linkInc, tetLocal;
+  std::vector<std::int32_t> linkDeg, linkInc, tetLocal, faceKey;
   std::vector<std::uint16_t> faceUses;
   auto discAround = [&](int v, const std::vector<std::int32_t>& around, bool linkOnly = false) {
     link.clear();
     if (around.empty()) return true;
     // Every tet of `around` has v; a face (v, a, b) is used by the tets with both a and b:
     // count the pairs of each tet's other three nodes in a table over v's neighbours.
-    // Each tet's nodes as local numbers (-1: v), read from the mesh once.
+    // Each tet's three other nodes as local numbers (in the tet's order), read from the mesh
+    // once.
     nbrs.clear();
-    tetLocal.resize(4 * around.size());
-    for (size_t i = 0; i < around.size(); ++i)
+    const size_t n = around.size();
+    tetLocal.resize(3 * n + 1);  // (+1: a tet without v writes a fourth number)
+    bool threeEach = true;       // (every tet has v once: its three other nodes)
+    for (size_t i = 0; i < n; ++i) {
+      const int t = around[i];
+      std::int32_t* o = &tetLocal[3 * i];
+      int m = 0;
       for (int k = 0; k < 4; ++k) {
-        const int w = mesh.T(around[i], k);
-        if (w == v) {
-          tetLocal[4 * i + k] = -1;
-          continue;
-        }
-        if (localId[w] < 0) {
-          localId[w] = static_cast<std::int32_t>(nbrs.size());
+        const int w = mesh.T(t, k);
+        if (w == v) continue;
+        std::int32_t& id = localId[w];
+        if (id < 0) {
+          id = static_cast<std::int32_t>(nbrs.size());
           nbrs.push_back(w);
         }
-        tetLocal[4 * i + k] = localId[w];
+        o[m++] = id;
       }
-    const size_t L = nbrs.size();
-    faceUses.assign(L * L, 0);
-    for (size_t i = 0; i < around.size(); ++i) {
-      std::int32_t o[3], m = 0;
-      for (int k = 0; k < 4; ++k)
-        if (tetLocal[4 * i + k] >= 0 && m < 3) o[m++] = tetLocal[4 * i + k];
-      for (int a = 0; a < m; ++a)
-        for (int b = a + 1; b < m; ++b) ++faceUses[std::min(o[a], o[b]) * L + std::max(o[a], o[b])];
+      threeEach = threeEach && m == 3;
     }
+    if (!threeEach) {  // not a star of v (never so here)
+      for (int w : nbrs) localId[w] = -1;
+      return false;
+    }
+    // The faces at v of each tet, in the order of the face opposite each other node (faces
+    // f != v's in order f = 0..3: without o[0], without o[1], without o[2]): the pairs
+    // (o1, o2), (o0, o2), (o0, o1), each as its table index min * L + max.
+    const std::int32_t L = static_cast<std::int32_t>(nbrs.size());
+    faceUses.assign(static_cast<size_t>(L) * L, 0);
+    faceKey.resize(3 * n);
+    for (size_t i = 0; i < n; ++i) {
+      const std::int32_t* o = &tetLocal[3 * i];
+      std::int32_t* key = &faceKey[3 * i];
+      const std::int32_t a = o[0], b = o[1], c = o[2];
+      key[0] = std::min(b, c) * L + std::max(b, c);
+      key[1] = std::min(a, c) * L + std::max(a, c);
+      key[2] = std::min(a, b) * L + std::max(a, b);
+      ++faceUses[key[0]];
+      ++faceUses[key[1]];
+      ++faceUses[key[2]];
+    }
+    // The boundary faces' edges, up to the first face used by more than two tets.
     bool manifold = true;
-    for (size_t i = 0; i < around.size() && manifold; ++i) {
-      const std::int32_t* tl = &tetLocal[4 * i];
-      int lv = 0;
-      while (tl[lv] >= 0) ++lv;
-      // The faces f != lv in order; face f at v: the two nodes other than f and lv.
-      for (int f = 0; f < 4; ++f) {
-        if (f == lv) continue;
-        std::int32_t o[2], m = 0;
-        for (int k = 0; k < 4; ++k)
-          if (k != f && k != lv) o[m++] = tl[k];
-        const std::uint16_t uses = faceUses[std::min(o[0], o[1]) * L + std::max(o[0], o[1])];
+    for (size_t i = 0; i < n && manifold; ++i) {
+      const std::int32_t* o = &tetLocal[3 * i];
+      const std::int32_t* key = &faceKey[3 * i];
+      for (int f = 0; f < 3; ++f) {
+        const std::uint16_t uses = faceUses[key[f]];
         if (uses > 2) {
           manifold = false;
           break;
         }
         if (uses == 1) {
-          link.push_back(nbrs[o[0]]);
-          link.push_back(nbrs[o[1]]);
+          const std::int32_t p = f == 0 ? o[1] : o[0], q = f == 2 ? o[1] : o[2];
+          link.push_back(p);
+          link.push_back(q);
         }
       }
     }
-    if (!manifold || link.empty() || linkOnly) {
-      for (int w : nbrs) localId[w] = -1;
-      return manifold;  // (link.empty(): an interior node)
-    }
+    for (int w : nbrs) localId[w] = -1;
+    if (!manifold || link.empty() || linkOnly) return manifold;  // (link.empty(): an interior node)
     // One closed loop: every link vertex has degree 2, and walking from one edge visits all.
     // Each link vertex's (first two) edges in a table over v's neighbours: with all degrees 2
     // the walk from edge 0 leaves each vertex by its other edge, and it visits all edges iff
     // they form one loop.
     const size_t edges = link.size() / 2;
     linkDeg.assign(L, 0);
-    linkInc.resize(2 * L);
+    linkInc.resize(2 * static_cast<size_t>(L));
     for (size_t i = 0; i < link.size(); ++i) {
-      const std::int32_t id = localId[link[i]];
+      const std::int32_t id = link[i];
       if (linkDeg[id] < 2) linkInc[2 * id + linkDeg[id]] = static_cast<std::int32_t>(i / 2);
       ++linkDeg[id];
     }
     bool loop = true;
-    for (size_t i = 0; i < link.size() && loop; ++i) loop = linkDeg[localId[link[i]]] == 2;
+    for (size_t i = 0; i < link.size() && loop; ++i) loop = linkDeg[link[i]] == 2;
     size_t visited = 1;
     std::int32_t start = link[0], at = link[1];
     std::int32_t prevEdge = 0;
     while (loop && at != start && visited <= edges) {
-      const std::int32_t id = localId[at];
-      const std::int32_t next = linkInc[2 * id] != prevEdge ? linkInc[2 * id] : linkInc[2 * id + 1];
+      const std::int32_t next = linkInc[2 * at] != prevEdge ? linkInc[2 * at] : linkInc[2 * at + 1];
       at = link[2 * next] == at ? link[2 * next + 1] : link[2 * next];
       prevEdge = next;
       ++visited;
     }
-    for (int w : nbrs) localId[w] = -1;
     return loop && at == start && visited == edges;
   };
   std::vector<std::int32_t> around;
@@ -1175,6 +1194,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     if (!(options.collapse_fraction > 0)) return;
     std::vector<std::uint8_t> locked(N, 0);
     std::vector<std::int32_t> dying, changing, vstar, checked;
+    std::vector<double> detAfter;  // per changing tet: 6 x its volume after the collapse
     std::vector<std::array<std::int32_t, 4>> keysB;
     struct Cand {
       double len;
@@ -1197,11 +1217,23 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
         const double q = tetQ(t);
         if (lastResort && !(q < options.flap_quality)) return;
         double mean = 0, lens[6];
+        const Vec3 p[4] = {pos(mesh.T(t, 0)), pos(mesh.T(t, 1)), pos(mesh.T(t, 2)), pos(mesh.T(t, 3))};
         for (int a = 0, e = 0; a < 4; ++a)
           for (int b = a + 1; b < 4; ++b, ++e) {
-            lens[e] = (pos(mesh.T(t, a)) - pos(mesh.T(t, b))).norm();
+            lens[e] = (p[a] - p[b]).norm();
             mean += lens[e] / 6.0;
           }
+        // A tet at or above quality_target has only its short edges: none where the shortest
+        // is not below collapse_fraction x the longest (a bound on the mean: the six rounded
+        // sixths add up to at most hi (1 + 6 eps) < hi (1 + 1e-9)) or the local edge.
+        if (q >= options.quality_target) {
+          double lo = lens[0], hi = lens[0];
+          for (int e = 1; e < 6; ++e) {
+            lo = std::min(lo, lens[e]);
+            hi = std::max(hi, lens[e]);
+          }
+          if (lo >= options.collapse_fraction * std::max(hi * (1 + 1e-9), region.edge_length)) return;
+        }
         for (int a = 0, e = 0; a < 4; ++a)
           for (int b = a + 1; b < 4; ++b, ++e) {
             const int x = mesh.T(t, a), y = mesh.T(t, b);
@@ -1232,31 +1264,49 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     // Sorted by length (then ends); an edge comes once per poor tet around it: one candidate
     // per (u, v), short if any of its copies is (a short edge's test accepts what the other
     // accepts, and copies would be tried one after the other on the same mesh).
-    auto sortMerge = [](std::vector<Cand>& c) {
-      std::sort(c.begin(), c.end(), [](const Cand& p, const Cand& q) {
-        return p.len != q.len ? p.len < q.len : p.u != q.u ? p.u < q.u : p.v < q.v;
-      });
+    auto byKey = [](const Cand& p, const Cand& q) {
+      return p.len != q.len ? p.len < q.len : p.u != q.u ? p.u < q.u : p.v < q.v;
+    };
+    // (c sorted by byKey: copies of a candidate are neighbours, in any order; the first
+    // copy's fields are kept, the same for every copy but the tet, which the loop below does
+    // not read.)
+    // (Into `out`, which is resized to c's size first and then cut to the merged count.)
+    auto mergeCopies = [](const std::vector<Cand>& c, std::vector<Cand>& out) {
+      out.resize(c.size());
       size_t kept = 0;
       for (size_t i = 0; i < c.size(); ++i) {
-        if (kept > 0 && c[kept - 1].len == c[i].len && c[kept - 1].u == c[i].u && c[kept - 1].v == c[i].v) {
-          c[kept - 1].shortEdge = c[kept - 1].shortEdge || c[i].shortEdge;
+        if (kept > 0 && out[kept - 1].len == c[i].len && out[kept - 1].u == c[i].u && out[kept - 1].v == c[i].v) {
+          out[kept - 1].shortEdge = out[kept - 1].shortEdge || c[i].shortEdge;
           continue;
         }
-        c[kept++] = c[i];
+        out[kept++] = c[i];
       }
-      c.resize(kept);
+      out.resize(kept);
     };
+#ifdef HYSIM_CHECK_EXACT
+    auto sortMerge = [&](std::vector<Cand>& c) {
+      std::sort(c.begin(), c.end(), byKey);
+      const std::vector<Cand> all = c;
+      mergeCopies(all, c);
+    };
+#endif
+    // `raw` is kept sorted by byKey: the first batch sorts it; a later batch drops the
+    // candidates of the changed tets (the rest stays sorted), sorts the new ones and merges
+    // the two runs. The list is then the same as a sort of the whole (the same elements; copies
+    // only differ in their tet).
     for (int batch = 0; batch < 3; ++batch) {
       if (batch == 0) {
         std::vector<std::int32_t> seen;
         regionTets(seen);
         raw.clear();
         for (int t : seen) candidatesOf(t, raw);
+        std::sort(raw.begin(), raw.end(), byKey);
       } else {
         for (int t : changedTets) tetChanged[t] = 1;
         raw.erase(std::remove_if(raw.begin(), raw.end(),
                                  [&](const Cand& c) { return (*dead)[c.tet] || tetChanged[c.tet]; }),
                   raw.end());
+        const size_t kept = raw.size();
         for (int t : changedTets) {
           if (!tetChanged[t]) continue;  // (a tet changed twice: once)
           tetChanged[t] = 0;
@@ -1265,9 +1315,13 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
           if (inRegion) candidatesOf(t, raw);
         }
         changedTets.clear();
+        const auto mid = raw.begin() + static_cast<std::ptrdiff_t>(kept);
+        std::sort(mid, raw.end(), byKey);
+        cands.clear();
+        std::merge(raw.begin(), mid, mid, raw.end(), std::back_inserter(cands), byKey);
+        raw.swap(cands);
       }
-      cands.assign(raw.begin(), raw.end());
-      sortMerge(cands);
+      mergeCopies(raw, cands);
 #ifdef HYSIM_CHECK_EXACT
       {  // the same list as from scratch
         std::vector<std::int32_t> seen;
@@ -1286,37 +1340,69 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       for (const Cand& c : cands) {
         const int u = c.u, v = c.v;
         if (locked[u] || locked[v]) continue;
+        // One pass over u's live tets: those with v die, the others change (u becomes v).
+        // Checks in order of cost, all must pass and have no side effects (so the first
+        // failure rejects, whichever it is): off the cut, one material (every live tet of u,
+        // that is the dying and changing ones, has the label of the first); no changed tet
+        // inverts or goes flat (its determinant with v for u, in tetVolumeHere's scalar
+        // arithmetic: Eigen's (p1 - p0).dot((p2 - p0).cross(p3 - p0)), the same value; kept
+        // for the volume check below); the edge is still an edge (a tet dies).
         dying.clear();
         changing.clear();
-        for (const std::int32_t *s = starB(u), *sEnd = starE(u); s < sEnd; ++s) {
-          const int t = (*s);
-          if ((*dead)[t]) continue;
-          bool hasV = false;
-          for (int k = 0; k < 4; ++k) hasV = hasV || mesh.T(t, k) == v;
-          (hasV ? dying : changing).push_back(t);
-        }
-        if (dying.empty()) continue;  // not an edge any more
-        if (c.offCut) {
-          // Off the cut: within one material (the boundary check, which costs more, comes
-          // after the geometric ones; all checks must pass and have no side effects).
-          bool oneMaterial = true;
-          for (int t : dying) oneMaterial = oneMaterial && mesh.material(t) == mesh.material(dying[0]);
-          for (int t : changing) oneMaterial = oneMaterial && mesh.material(t) == mesh.material(dying[0]);
-          if (!oneMaterial) continue;
-        }
-        // Checks in order of cost (all must pass): no changed tet inverts or goes flat, the
-        // volume changes within the limits, the worst q* rises (short edges: does not fall).
+        detAfter.clear();
         bool ok = true;
-        const Vec3 xv = pos(v);
-        for (int t : changing) {
-          Vec3 p[4];
-          for (int k = 0; k < 4; ++k) p[k] = mesh.T(t, k) == u ? xv : pos(mesh.T(t, k));
-          if (!((p[1] - p[0]).dot((p[2] - p[0]).cross(p[3] - p[0])) > 0)) {
-            ok = false;
-            break;
+        {
+          const double* cx = mesh.X.col(0).data();
+          const double* cy = mesh.X.col(1).data();
+          const double* cz = mesh.X.col(2).data();
+          const double vx = cx[v], vy = cy[v], vz = cz[v];
+          std::int32_t mat0 = 0;
+          bool first = true;
+          for (const std::int32_t *s = starB(u), *sEnd = starE(u); s < sEnd; ++s) {
+            const int t = (*s);
+            if ((*dead)[t]) continue;
+            if (c.offCut) {
+              const std::int32_t m = mesh.material(t);
+              if (first) {
+                mat0 = m;
+                first = false;
+              } else if (m != mat0) {
+                ok = false;
+                break;
+              }
+            }
+            const int i0 = mesh.T(t, 0), i1 = mesh.T(t, 1), i2 = mesh.T(t, 2), i3 = mesh.T(t, 3);
+            if ((i0 == v) | (i1 == v) | (i2 == v) | (i3 == v)) {
+              dying.push_back(t);
+              continue;
+            }
+            const double x0 = i0 == u ? vx : cx[i0], y0 = i0 == u ? vy : cy[i0], z0 = i0 == u ? vz : cz[i0];
+            const double x1 = i1 == u ? vx : cx[i1], y1 = i1 == u ? vy : cy[i1], z1 = i1 == u ? vz : cz[i1];
+            const double x2 = i2 == u ? vx : cx[i2], y2 = i2 == u ? vy : cy[i2], z2 = i2 == u ? vz : cz[i2];
+            const double x3 = i3 == u ? vx : cx[i3], y3 = i3 == u ? vy : cy[i3], z3 = i3 == u ? vz : cz[i3];
+            const double ax = x1 - x0, ay = y1 - y0, az = z1 - z0;
+            const double bx = x2 - x0, by = y2 - y0, bz = z2 - z0;
+            const double ex = x3 - x0, ey = y3 - y0, ez = z3 - z0;
+            const double nx = by * ez - bz * ey, ny = bz * ex - bx * ez, nz = bx * ey - by * ex;
+            const double det = (ax * nx + ay * ny) + az * nz;
+#ifdef HYSIM_CHECK_EXACT
+            {
+              Vec3 p[4];
+              for (int k = 0; k < 4; ++k) p[k] = mesh.T(t, k) == u ? pos(v) : pos(mesh.T(t, k));
+              const double ref = (p[1] - p[0]).dot((p[2] - p[0]).cross(p[3] - p[0]));
+              if (std::memcmp(&ref, &det, sizeof det) != 0) std::abort();
+            }
+#endif
+            if (!(det > 0)) {
+              ok = false;
+              break;
+            }
+            changing.push_back(t);
+            detAfter.push_back(det);
           }
         }
-        if (!ok) continue;
+        if (!ok || dying.empty()) continue;
+        const Vec3 xv = pos(v);
         // Volume: the removed tets and the change of the others, against u's star.
         double before = 0, after = 0;
         matVol.clear();
@@ -1325,12 +1411,11 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
           before += vt;
           matAdd(t, vt, 0.0);
         }
-        for (int t : changing) {
+        for (size_t i = 0; i < changing.size(); ++i) {
+          const int t = changing[i];
           const double vt = tetVolumeHere(mesh, t);
           before += vt;
-          Vec3 p[4];
-          for (int k = 0; k < 4; ++k) p[k] = mesh.T(t, k) == u ? pos(v) : pos(mesh.T(t, k));
-          const double vol = (p[1] - p[0]).dot((p[2] - p[0]).cross(p[3] - p[0])) / 6.0;
+          const double vol = detAfter[i] / 6.0;
           after += vol;
           matAdd(t, vt, vol);
         }
