@@ -1862,11 +1862,12 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
             }
             y = best;
           }
-          // The checks below must all pass and have no side effects: the cheapest first (the
-          // worst tet, which starAbove tries first anyway), the surface queries after it.
+          // The checks below must all pass and have no side effects on the outcome (their
+          // caches and starAbove's lastBelow only skip or order work), so any order gives the
+          // same moves: the cheapest first (the worst tet, which starAbove tries first anyway),
+          // then the volume check (it fails often), the surface queries after it.
           const double qFirst = tetQAt(wt, n, y);
           if (!(qFirst > best)) continue;
-          if (!sideOk(y)) continue;
           // Moves on a curved surface change the volume a little (the faces are chords): within the budget.
           double dv = 0;
           if (curved && (c.kind == Freedom::Surface || c.kind == Freedom::Fan || c.kind == Freedom::Ridge)) {
@@ -1882,6 +1883,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
             }
             if (!moveBudget.fits(dv) || std::abs(dv) > options.move_volume_fraction * edgeTet) continue;
           }
+          if (!sideOk(y)) continue;
           double q = 0;
           if (starAbove(n, y, wt, qFirst, best, &q)) {
             best = q;
