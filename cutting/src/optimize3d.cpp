@@ -1874,12 +1874,36 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
             if (starVolume.empty())  // the star's volumes where n is (the same for every candidate)
               for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s)
                 starVolume.push_back((*dead)[*s] ? 0.0 : tetVolumeHere(mesh, *s));
+            // (The volume of each tet with n at y in scalars, as tetVolumeHere: the same value
+            // as the vector expression (p1 - p0).dot((p2 - p0).cross(p3 - p0)).)
             const double* oldVolume = starVolume.data();
+            const double* cx = mesh.X.col(0).data();
+            const double* cy = mesh.X.col(1).data();
+            const double* cz = mesh.X.col(2).data();
             for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s, ++oldVolume) {
               if ((*dead)[*s]) continue;
-              Vec3 p[4];
-              for (int k = 0; k < 4; ++k) p[k] = mesh.T(*s, k) == n ? y : pos(mesh.T(*s, k));
-              dv += (p[1] - p[0]).dot((p[2] - p[0]).cross(p[3] - p[0])) / 6.0 - *oldVolume;
+              double px[4], py[4], pz[4];
+              for (int k = 0; k < 4; ++k) {
+                const int v = mesh.T(*s, k);
+                const bool here = v == n;
+                px[k] = here ? y[0] : cx[v];
+                py[k] = here ? y[1] : cy[v];
+                pz[k] = here ? y[2] : cz[v];
+              }
+              const double ax = px[1] - px[0], ay = py[1] - py[0], az = pz[1] - pz[0];
+              const double bx = px[2] - px[0], by = py[2] - py[0], bz = pz[2] - pz[0];
+              const double ex = px[3] - px[0], ey = py[3] - py[0], ez = pz[3] - pz[0];
+              const double nx = by * ez - bz * ey, ny = bz * ex - bx * ez, nz = bx * ey - by * ex;
+              const double vol6 = (ax * nx + ay * ny) + az * nz;
+#ifdef HYSIM_CHECK_EXACT
+              {
+                Vec3 p[4];
+                for (int k = 0; k < 4; ++k) p[k] = mesh.T(*s, k) == n ? y : pos(mesh.T(*s, k));
+                const double ref = (p[1] - p[0]).dot((p[2] - p[0]).cross(p[3] - p[0]));
+                if (std::memcmp(&ref, &vol6, sizeof vol6) != 0) std::abort();
+              }
+#endif
+              dv += vol6 / 6.0 - *oldVolume;
             }
             if (!moveBudget.fits(dv) || std::abs(dv) > options.move_volume_fraction * edgeTet) continue;
           }
