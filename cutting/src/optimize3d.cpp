@@ -295,11 +295,26 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   // Worst q* around n where it is (tetQAt at its own position, through the cache).
   auto starWorst = [&](int n, int* worstTet) {
     double q = 1.0;
+    const double* cx = mesh.X.col(0).data();
+    const double* cy = mesh.X.col(1).data();
+    const double* cz = mesh.X.col(2).data();
     for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s) {
       const int t = (*s);
       if ((*dead)[t]) continue;
-      const Vec3 p0 = pos(mesh.T(t, 0)), p1 = pos(mesh.T(t, 1)), p2 = pos(mesh.T(t, 2)), p3 = pos(mesh.T(t, 3));
-      const double qt = (p1 - p0).dot((p2 - p0).cross(p3 - p0)) > 0 ? tetQ(t) : -1.0;
+      // (The orientation in scalars over the coordinate columns, as tetVolumeHere: the same
+      // value as the vector expression (p1 - p0).dot((p2 - p0).cross(p3 - p0)).)
+      const int i0 = mesh.T(t, 0), i1 = mesh.T(t, 1), i2 = mesh.T(t, 2), i3 = mesh.T(t, 3);
+      const double ax = cx[i1] - cx[i0], ay = cy[i1] - cy[i0], az = cz[i1] - cz[i0];
+      const double bx = cx[i2] - cx[i0], by = cy[i2] - cy[i0], bz = cz[i2] - cz[i0];
+      const double ex = cx[i3] - cx[i0], ey = cy[i3] - cy[i0], ez = cz[i3] - cz[i0];
+      const double nx = by * ez - bz * ey, ny = bz * ex - bx * ez, nz = bx * ey - by * ex;
+      const double vol6 = (ax * nx + ay * ny) + az * nz;
+#ifdef HYSIM_CHECK_EXACT
+      const Vec3 p0 = pos(i0), p1 = pos(i1), p2 = pos(i2), p3 = pos(i3);
+      const double ref = (p1 - p0).dot((p2 - p0).cross(p3 - p0));
+      if (std::memcmp(&ref, &vol6, sizeof vol6) != 0) std::abort();
+#endif
+      const double qt = vol6 > 0 ? tetQ(t) : -1.0;
       if (qt < q) {
         q = qt;
         if (worstTet) *worstTet = (*s);
