@@ -304,11 +304,26 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   // Worst q* around n where it is (tetQAt at its own position, through the cache).
   auto starWorst = [&](int n, int* worstTet) {
     double q = 1.0;
+    const double* cx = mesh.X.col(0).data();
+    const double* cy = mesh.X.col(1).data();
+    const double* cz = mesh.X.col(2).data();
     for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s) {
       const int t = (*s);
       if ((*dead)[t]) continue;
-      const Vec3 p0 = pos(mesh.T(t, 0)), p1 = pos(mesh.T(t, 1)), p2 = pos(mesh.T(t, 2)), p3 = pos(mesh.T(t, 3));
-      const double qt = (p1 - p0).dot((p2 - p0).cross(p3 - p0)) > 0 ? tetQ(t) : -1.0;
+      // (The orientation in scalars over the coordinate columns, as tetVolumeHere: the same
+      // value as the vector expression (p1 - p0).dot((p2 - p0).cross(p3 - p0)).)
+      const int i0 = mesh.T(t, 0), i1 = mesh.T(t, 1), i2 = mesh.T(t, 2), i3 = mesh.T(t, 3);
+      const double ax = cx[i1] - cx[i0], ay = cy[i1] - cy[i0], az = cz[i1] - cz[i0];
+      const double bx = cx[i2] - cx[i0], by = cy[i2] - cy[i0], bz = cz[i2] - cz[i0];
+      const double ex = cx[i3] - cx[i0], ey = cy[i3] - cy[i0], ez = cz[i3] - cz[i0];
+      const double nx = by * ez - bz * ey, ny = bz * ex - bx * ez, nz = bx * ey - by * ex;
+      const double vol6 = (ax * nx + ay * ny) + az * nz;
+#ifdef HYSIM_CHECK_EXACT
+      const Vec3 p0 = pos(i0), p1 = pos(i1), p2 = pos(i2), p3 = pos(i3);
+      const double ref = (p1 - p0).dot((p2 - p0).cross(p3 - p0));
+      if (std::memcmp(&ref, &vol6, sizeof vol6) != 0) std::abort();
+#endif
+      const double qt = vol6 > 0 ? tetQ(t) : -1.0;
       if (qt < q) {
         q = qt;
         if (worstTet) *worstTet = (*s);
@@ -1947,26 +1962,52 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
             }
             y = best;
           }
-          // The checks below must all pass and have no side effects: the cheapest first (the
-          // worst tet, which starAbove tries first anyway), the surface queries after it.
+          // The checks below must all pass and have no side effects on the outcome (their
+          // caches and starAbove's lastBelow only skip or order work), so any order gives the
+          // same moves: the cheapest first (the worst tet, which starAbove tries first anyway),
+          // then the volume check (it fails often), the surface queries after it.
           const double qFirst = tetQAt(wt, n, y);
           if (!(qFirst > best)) continue;
-          if (!sideOk(y)) continue;
           // Moves on a curved surface change the volume a little (the faces are chords): within the budget.
           double dv = 0;
           if (curved && (c.kind == Freedom::Surface || c.kind == Freedom::Fan || c.kind == Freedom::Ridge)) {
             if (starVolume.empty())  // the star's volumes where n is (the same for every candidate)
               for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s)
                 starVolume.push_back((*dead)[*s] ? 0.0 : tetVolumeHere(mesh, *s));
+            // (The volume of each tet with n at y in scalars, as tetVolumeHere: the same value
+            // as the vector expression (p1 - p0).dot((p2 - p0).cross(p3 - p0)).)
             const double* oldVolume = starVolume.data();
+            const double* cx = mesh.X.col(0).data();
+            const double* cy = mesh.X.col(1).data();
+            const double* cz = mesh.X.col(2).data();
             for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s, ++oldVolume) {
               if ((*dead)[*s]) continue;
-              Vec3 p[4];
-              for (int k = 0; k < 4; ++k) p[k] = mesh.T(*s, k) == n ? y : pos(mesh.T(*s, k));
-              dv += (p[1] - p[0]).dot((p[2] - p[0]).cross(p[3] - p[0])) / 6.0 - *oldVolume;
+              double px[4], py[4], pz[4];
+              for (int k = 0; k < 4; ++k) {
+                const int v = mesh.T(*s, k);
+                const bool here = v == n;
+                px[k] = here ? y[0] : cx[v];
+                py[k] = here ? y[1] : cy[v];
+                pz[k] = here ? y[2] : cz[v];
+              }
+              const double ax = px[1] - px[0], ay = py[1] - py[0], az = pz[1] - pz[0];
+              const double bx = px[2] - px[0], by = py[2] - py[0], bz = pz[2] - pz[0];
+              const double ex = px[3] - px[0], ey = py[3] - py[0], ez = pz[3] - pz[0];
+              const double nx = by * ez - bz * ey, ny = bz * ex - bx * ez, nz = bx * ey - by * ex;
+              const double vol6 = (ax * nx + ay * ny) + az * nz;
+#ifdef HYSIM_CHECK_EXACT
+              {
+                Vec3 p[4];
+                for (int k = 0; k < 4; ++k) p[k] = mesh.T(*s, k) == n ? y : pos(mesh.T(*s, k));
+                const double ref = (p[1] - p[0]).dot((p[2] - p[0]).cross(p[3] - p[0]));
+                if (std::memcmp(&ref, &vol6, sizeof vol6) != 0) std::abort();
+              }
+#endif
+              dv += vol6 / 6.0 - *oldVolume;
             }
             if (!moveBudget.fits(dv) || std::abs(dv) > options.move_volume_fraction * edgeTet) continue;
           }
+          if (!sideOk(y)) continue;
           double q = 0;
           if (starAbove(n, y, wt, qFirst, best, &q)) {
             best = q;
