@@ -1079,7 +1079,17 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
     std::vector<std::int32_t> cutStarOff(numCut + 1, 0), cutStarTet;
     std::vector<std::array<std::int32_t, 2>> incidence;
     incidence.reserve(4 * local.size());
-    for (int t = 0; t < static_cast<int>(inLocal.size()); ++t) {
+    // (The flags are scanned eight at a time: few tets are local.)
+    const int numFlags = static_cast<int>(inLocal.size());
+    for (int t = 0; t < numFlags; ++t) {
+      if ((t & 7) == 0 && t + 8 <= numFlags) {
+        std::uint64_t word;
+        std::memcpy(&word, inLocal.data() + t, 8);
+        if (word == 0) {
+          t += 7;
+          continue;
+        }
+      }
       if (!inLocal[t]) continue;
       for (const int v : w.tet(t)) {
         const std::int32_t sl = slot[v];
