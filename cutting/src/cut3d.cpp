@@ -1348,8 +1348,17 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
         --u[c3[t]];
       }
     }
+    // Kept nodes numbered in order; the others (ascending) go.
     int mn = 0;
-    for (int i = 0; i < N1; ++i) nodeMap[i] = nodeMap[i] >= 0 ? mn++ : -1;
+    std::vector<std::int32_t> gone;
+    for (int i = 0; i < N1; ++i) {
+      if (nodeMap[i] >= 0) {
+        nodeMap[i] = mn++;
+      } else {
+        nodeMap[i] = -1;
+        gone.push_back(i);
+      }
+    }
     // Kept rows in runs between the dropped tets (nodes likewise).
     auto keepRows = [](const auto& from, auto& to, const std::vector<std::int32_t>& gaps) {
       Eigen::Index src = 0, dst = 0;
@@ -1368,9 +1377,6 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
       keepRows(out.T, compact.T, drop);
       compact.X = std::move(out.X);
     } else {
-      std::vector<std::int32_t> gone;
-      for (int i = 0; i < N1; ++i)
-        if (nodeMap[i] < 0) gone.push_back(i);
       compact.X.resize(mn, 3);
       keepRows(out.X, compact.X, gone);
       // The kept tets' rows, renumbered as they are copied.
@@ -1387,7 +1393,7 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
       }
     }
     out = std::move(compact);
-    for (int i = 0; i < N0; ++i) change.node_old_to_new[i] = nodeMap[i];
+    std::copy(nodeMap.begin(), nodeMap.begin() + N0, change.node_old_to_new.begin());
     // Old tets: each is its own index or -1 (split) so far; kept ones shift down with tetMap
     // (in runs), dropped ones go.
     {
