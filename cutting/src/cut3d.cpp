@@ -414,15 +414,13 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
     std::vector<std::uint8_t> outcode(N0);
     {
       const Eigen::Array3d blo = surface.bounds().min().array() - 2 * eps, bhi = surface.bounds().max().array() + 2 * eps;
-      for (int i = 0; i < N0; ++i) {
-        std::uint8_t c = 0;
-        for (int d = 0; d < 3; ++d) {
-          const double x = input.X(i, d);
-          c |= static_cast<std::uint8_t>((x < blo[d] ? 1 : 0) << (2 * d));
-          c |= static_cast<std::uint8_t>((x > bhi[d] ? 1 : 0) << (2 * d + 1));
-        }
-        outcode[i] = c;
-      }
+      // Column by column (contiguous coordinates: the compares vectorise).
+      const double *x0 = input.X.col(0).data(), *x1 = input.X.col(1).data(), *x2 = input.X.col(2).data();
+      const double lo0 = blo[0], lo1 = blo[1], lo2 = blo[2], hi0 = bhi[0], hi1 = bhi[1], hi2 = bhi[2];
+      std::uint8_t* oc = outcode.data();
+      for (int i = 0; i < N0; ++i)
+        oc[i] = static_cast<std::uint8_t>((x0[i] < lo0 ? 1 : 0) | (x0[i] > hi0 ? 2 : 0) | (x1[i] < lo1 ? 4 : 0) |
+                                          (x1[i] > hi1 ? 8 : 0) | (x2[i] < lo2 ? 16 : 0) | (x2[i] > hi2 ? 32 : 0));
     }
     for (int t = 0; t < M0; ++t) {
       if (outcode[input.T(t, 0)] & outcode[input.T(t, 1)] & outcode[input.T(t, 2)] & outcode[input.T(t, 3)]) continue;
@@ -1079,7 +1077,17 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
     std::vector<std::int32_t> cutStarOff(numCut + 1, 0), cutStarTet;
     std::vector<std::array<std::int32_t, 2>> incidence;
     incidence.reserve(4 * local.size());
-    for (int t = 0; t < static_cast<int>(inLocal.size()); ++t) {
+    // (The flags are scanned eight at a time: few tets are local.)
+    const int numFlags = static_cast<int>(inLocal.size());
+    for (int t = 0; t < numFlags; ++t) {
+      if ((t & 7) == 0 && t + 8 <= numFlags) {
+        std::uint64_t word;
+        std::memcpy(&word, inLocal.data() + t, 8);
+        if (word == 0) {
+          t += 7;
+          continue;
+        }
+      }
       if (!inLocal[t]) continue;
       for (const int v : w.tet(t)) {
         const std::int32_t sl = slot[v];
@@ -1340,8 +1348,17 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
         --u[c3[t]];
       }
     }
+    // Kept nodes numbered in order; the others (ascending) go.
     int mn = 0;
-    for (int i = 0; i < N1; ++i) nodeMap[i] = nodeMap[i] >= 0 ? mn++ : -1;
+    std::vector<std::int32_t> gone;
+    for (int i = 0; i < N1; ++i) {
+      if (nodeMap[i] >= 0) {
+        nodeMap[i] = mn++;
+      } else {
+        nodeMap[i] = -1;
+        gone.push_back(i);
+      }
+    }
     // Kept rows in runs between the dropped tets (nodes likewise).
     auto keepRows = [](const auto& from, auto& to, const std::vector<std::int32_t>& gaps) {
       Eigen::Index src = 0, dst = 0;
@@ -1360,9 +1377,6 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
       keepRows(out.T, compact.T, drop);
       compact.X = std::move(out.X);
     } else {
-      std::vector<std::int32_t> gone;
-      for (int i = 0; i < N1; ++i)
-        if (nodeMap[i] < 0) gone.push_back(i);
       compact.X.resize(mn, 3);
       keepRows(out.X, compact.X, gone);
       // The kept tets' rows, renumbered as they are copied.
@@ -1379,7 +1393,7 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
       }
     }
     out = std::move(compact);
-    for (int i = 0; i < N0; ++i) change.node_old_to_new[i] = nodeMap[i];
+    std::copy(nodeMap.begin(), nodeMap.begin() + N0, change.node_old_to_new.begin());
     // Old tets: each is its own index or -1 (split) so far; kept ones shift down with tetMap
     // (in runs), dropped ones go.
     {
