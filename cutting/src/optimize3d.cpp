@@ -49,10 +49,10 @@ namespace {
 using Vec3 = Eigen::Vector3d;
 constexpr int kFace[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
 
-// tetVolume (mesh.cpp) inlined, in scalars over the coordinate columns: Eigen's cross
-// (y1 z2 - z1 y2, z1 x2 - x1 z2, x1 y2 - y1 x2) and 3-vector dot ((a0 b0 + a1 b1) + a2 b2),
-// the same expression and value as the mesh volume below (checked there bit for bit).
-inline double tetVolumeHere(const TetMesh& mesh, int t) {
+// Six times tetVolume (mesh.cpp), inlined, in scalars over the coordinate columns: Eigen's
+// cross (y1 z2 - z1 y2, z1 x2 - x1 z2, x1 y2 - y1 x2) and 3-vector dot ((a0 b0 + a1 b1) +
+// a2 b2), the same value as (x1 - x0).dot((x2 - x0).cross(x3 - x0)) (checked bit for bit).
+inline double tetVolume6Here(const TetMesh& mesh, int t) {
   const double* cx = mesh.X.col(0).data();
   const double* cy = mesh.X.col(1).data();
   const double* cz = mesh.X.col(2).data();
@@ -61,7 +61,17 @@ inline double tetVolumeHere(const TetMesh& mesh, int t) {
   const double bx = cx[i2] - cx[i0], by = cy[i2] - cy[i0], bz = cz[i2] - cz[i0];
   const double ex = cx[i3] - cx[i0], ey = cy[i3] - cy[i0], ez = cz[i3] - cz[i0];
   const double nx = by * ez - bz * ey, ny = bz * ex - bx * ez, nz = bx * ey - by * ex;
-  const double v = ((ax * nx + ay * ny) + az * nz) / 6.0;
+  const double v6 = (ax * nx + ay * ny) + az * nz;
+#ifdef HYSIM_CHECK_EXACT
+  const Eigen::Vector3d x0 = mesh.X.row(i0), x1 = mesh.X.row(i1), x2 = mesh.X.row(i2), x3 = mesh.X.row(i3);
+  const double ref = (x1 - x0).dot((x2 - x0).cross(x3 - x0));
+  if (std::memcmp(&ref, &v6, sizeof v6) != 0) std::abort();
+#endif
+  return v6;
+}
+// tetVolume (mesh.cpp) inlined: the same value.
+inline double tetVolumeHere(const TetMesh& mesh, int t) {
+  const double v = tetVolume6Here(mesh, t) / 6.0;
 #ifdef HYSIM_CHECK_EXACT
   const double ref = tetVolume(mesh, t);
   if (std::memcmp(&ref, &v, sizeof v) != 0) std::abort();
@@ -189,30 +199,10 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   };
   buildStars();
   // Peeling and collapses change the volume; together they may change it by at most
-  // volume_budget of the mesh's volume.
-  // tetVolume's arithmetic in scalars (Eigen's cross is (y1 z2 - z1 y2, z1 x2 - x1 z2,
-  // x1 y2 - y1 x2), its 3-vector dot (a0 b0 + a1 b1) + a2 b2): the same value, without the
-  // out-of-line cross product per tet. X is column-major: three coordinate columns.
+  // volume_budget of the mesh's volume (tetVolume's value per tet, in scalars without the
+  // out-of-line cross product: tetVolumeHere).
   double meshVolume = 0;
-  {
-    const double* cx = mesh.X.col(0).data();
-    const double* cy = mesh.X.col(1).data();
-    const double* cz = mesh.X.col(2).data();
-    for (int t = 0; t < M; ++t) {
-      const int i0 = mesh.T(t, 0), i1 = mesh.T(t, 1), i2 = mesh.T(t, 2), i3 = mesh.T(t, 3);
-      const double ax = cx[i1] - cx[i0], ay = cy[i1] - cy[i0], az = cz[i1] - cz[i0];
-      const double bx = cx[i2] - cx[i0], by = cy[i2] - cy[i0], bz = cz[i2] - cz[i0];
-      const double ex = cx[i3] - cx[i0], ey = cy[i3] - cy[i0], ez = cz[i3] - cz[i0];
-      const double nx = by * ez - bz * ey, ny = bz * ex - bx * ez, nz = bx * ey - by * ex;
-      const double v = (ax * nx + ay * ny) + az * nz;
-#ifdef HYSIM_CHECK_EXACT
-      const Vec3 x0 = mesh.X.row(i0), x1 = mesh.X.row(i1), x2 = mesh.X.row(i2), x3 = mesh.X.row(i3);
-      const double ref = (x1 - x0).dot((x2 - x0).cross(x3 - x0));
-      if (std::memcmp(&ref, &v, sizeof v) != 0) std::abort();
-#endif
-      meshVolume += v / 6.0;
-    }
-  }
+  for (int t = 0; t < M; ++t) meshVolume += tetVolumeHere(mesh, t);
   // Curved cuts: the budgets bound the net change of the mesh volume (collapses and moves
   // add and remove volume; what they move about cancels) and, at volume_churn_factor x
   // that, the sum of the absolute changes. Plane cuts: the sum of the absolute changes.
@@ -304,25 +294,10 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   // Worst q* around n where it is (tetQAt at its own position, through the cache).
   auto starWorst = [&](int n, int* worstTet) {
     double q = 1.0;
-    const double* cx = mesh.X.col(0).data();
-    const double* cy = mesh.X.col(1).data();
-    const double* cz = mesh.X.col(2).data();
     for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s) {
       const int t = (*s);
       if ((*dead)[t]) continue;
-      // (The orientation in scalars over the coordinate columns, as tetVolumeHere: the same
-      // value as the vector expression (p1 - p0).dot((p2 - p0).cross(p3 - p0)).)
-      const int i0 = mesh.T(t, 0), i1 = mesh.T(t, 1), i2 = mesh.T(t, 2), i3 = mesh.T(t, 3);
-      const double ax = cx[i1] - cx[i0], ay = cy[i1] - cy[i0], az = cz[i1] - cz[i0];
-      const double bx = cx[i2] - cx[i0], by = cy[i2] - cy[i0], bz = cz[i2] - cz[i0];
-      const double ex = cx[i3] - cx[i0], ey = cy[i3] - cy[i0], ez = cz[i3] - cz[i0];
-      const double nx = by * ez - bz * ey, ny = bz * ex - bx * ez, nz = bx * ey - by * ex;
-      const double vol6 = (ax * nx + ay * ny) + az * nz;
-#ifdef HYSIM_CHECK_EXACT
-      const Vec3 p0 = pos(i0), p1 = pos(i1), p2 = pos(i2), p3 = pos(i3);
-      const double ref = (p1 - p0).dot((p2 - p0).cross(p3 - p0));
-      if (std::memcmp(&ref, &vol6, sizeof vol6) != 0) std::abort();
-#endif
+      const double vol6 = tetVolume6Here(mesh, t);  // (p1 - p0).dot((p2 - p0).cross(p3 - p0))
       const double qt = vol6 > 0 ? tetQ(t) : -1.0;
       if (qt < q) {
         q = qt;
