@@ -390,16 +390,9 @@ void BM_CutSurfaceBuild(benchmark::State& state) {
     state.SkipWithError("HYSIM_REPLAY_DIR unset or without pass_001_mesh.msh / pass_001_surface.msh");
     return;
   }
-  // Each dump's strip shape (rows x row_size), as bench::dumpedSurface finds it.
   std::vector<std::pair<int, int>> shape;
   for (const auto& t : surfaces) {
-    shape.emplace_back(0, 0);
-    for (int row_size = 2; row_size <= t.X.rows() / 2 && shape.back().first == 0; ++row_size) {
-      const int rows = static_cast<int>(t.X.rows() / row_size);
-      if (t.X.rows() % row_size == 0 && 2 * static_cast<Eigen::Index>(rows - 1) * (row_size - 1) == t.F.rows() &&
-          hysim::cutting::CutSurface::stripTriangles(rows, row_size) == t.F)
-        shape.back() = {rows, row_size};
-    }
+    shape.push_back(hysim::bench::stripShape(t));
     if (shape.back().first == 0) {
       state.SkipWithError("a dumped surface is not a strip");
       return;

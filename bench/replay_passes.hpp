@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <string>
+#include <utility>
 
 #include "hysim/cutting/cut_surface.hpp"
 #include "hysim/cutting/mesh_io.hpp"
@@ -25,20 +26,29 @@ inline bool readDumpedPass(int i, cutting::TetMesh& mesh, cutting::TriMesh& surf
   return true;
 }
 
+// The strip shape (rows, row_size) of a dumped surface whose triangles are
+// CutSurface::stripTriangles(rows, row_size), as the simulator writes them; (0, 0) otherwise.
+inline std::pair<int, int> stripShape(const cutting::TriMesh& tri) {
+  const auto n = tri.X.rows();
+  for (int row_size = 2; row_size <= n / 2; ++row_size) {
+    if (n % row_size != 0) continue;
+    const int rows = static_cast<int>(n / row_size);
+    if (2 * static_cast<Eigen::Index>(rows - 1) * (row_size - 1) != tri.F.rows()) continue;
+    if (cutting::CutSurface::stripTriangles(rows, row_size) == tri.F) return {rows, row_size};
+  }
+  return {0, 0};
+}
+
 // The pass's cut surface as the simulator builds it: a strip (CutSurface::strip) when the
-// triangles are a strip's (rows of equal length; they always are in a dump), else from the
-// triangles. HYSIM_REPLAY_SORTED_TREE set: from the triangles (the centroid-sorted tree)
-// always, for comparisons. The same surface either way (same triangles and numbers).
+// triangles are a strip's (they always are in a dump), else from the triangles.
+// HYSIM_REPLAY_SORTED_TREE set: from the triangles (the centroid-sorted tree) always, for
+// comparisons. The same surface either way (same triangles and numbers).
 inline Result<cutting::CutSurface> dumpedSurface(const cutting::TriMesh& tri) {
   const char* sorted = std::getenv("HYSIM_REPLAY_SORTED_TREE");
-  const auto n = tri.X.rows();
-  if (sorted == nullptr || *sorted == 0)
-    for (int row_size = 2; row_size <= n / 2; ++row_size) {
-      if (n % row_size != 0) continue;
-      const int rows = static_cast<int>(n / row_size);
-      if (2 * static_cast<Eigen::Index>(rows - 1) * (row_size - 1) != tri.F.rows()) continue;
-      if (cutting::CutSurface::stripTriangles(rows, row_size) == tri.F) return cutting::CutSurface::strip(tri.X, rows, row_size);
-    }
+  if (sorted == nullptr || *sorted == 0) {
+    const auto [rows, row_size] = stripShape(tri);
+    if (rows > 0) return cutting::CutSurface::strip(tri.X, rows, row_size);
+  }
   return cutting::CutSurface::triangles(tri.X, tri.F);
 }
 
