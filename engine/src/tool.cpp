@@ -3,6 +3,8 @@
 #include <Eigen/Geometry>
 #include <cmath>
 
+#include "hysim/cutting/cut_surface.hpp"
+
 namespace hysim::engine {
 
 void loopPoints(const LoopGeometry& loop, const haptics::ToolPose& pose, Eigen::Matrix<double, Eigen::Dynamic, 3>& out) {
@@ -76,16 +78,9 @@ Eigen::Matrix<double, Eigen::Dynamic, 3> Sweep::vertices() const {
 }
 
 Eigen::Matrix<int, Eigen::Dynamic, 3> Sweep::triangles() const {
-  Eigen::Matrix<int, Eigen::Dynamic, 3> f(2 * num_quads_, 3);
-  int t = 0;
-  for (int r = 0; r + 1 < num_rows_; ++r) {
-    for (int i = 0; i + 1 < row_size_; ++i) {
-      const int a = r * row_size_ + i, b = a + 1, c = a + row_size_, d = c + 1;
-      f.row(t++) << a, b, d;
-      f.row(t++) << a, d, c;
-    }
-  }
-  return f;
+  // The cut surface's strip layout (the pass cuts with CutSurface::strip of the same grid).
+  if (num_rows_ < 2) return Eigen::Matrix<int, Eigen::Dynamic, 3>(0, 3);
+  return cutting::CutSurface::stripTriangles(num_rows_, row_size_);
 }
 
 void Sweep::extendedSurface(double extra_mm, Eigen::Matrix<double, Eigen::Dynamic, 3>& vertices,
