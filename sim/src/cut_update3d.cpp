@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <string>
 
@@ -66,9 +67,15 @@ namespace {
 // the free nodes `nodes`, every other node held fixed (a principal submatrix), by Lanczos.
 // `start` (#N x 3, may be null or zero) is mixed into the deterministic start vector; `mode`
 // (#N x 3) receives the Ritz vector (zero outside `nodes`).
+// `decided(lambda)` (monotone: once true, true for every larger lambda) may end the iteration
+// early: the top Ritz value never decreases from one step to the next (T's leading block is
+// the previous T; Cauchy interlacing) and stays below the top eigenvalue, so once it is above
+// a value where `decided` holds, so is the value the full iteration would return. Then that
+// Ritz value is returned; the caller uses it only through `decided`.
+template <class Decided>
 double topEigenvalue(const Model& m, const cutting::Positions& X, const std::vector<int>& nodes,
                      const Eigen::MatrixX3d* start, const CutUpdate3DOptions& options, Eigen::MatrixX3d* mode,
-                     int* steps_taken) {
+                     int* steps_taken, const Decided& decided) {
   const int count = static_cast<int>(nodes.size());
   if (steps_taken) *steps_taken = 0;
   if (count == 0) return 0.0;
@@ -229,7 +236,7 @@ double topEigenvalue(const Model& m, const cutting::Positions& X, const std::vec
     // top eigenvalue of T is at most scale * max row sum of |T / scale| (Gershgorin), so when
     // b is above 1e-14 times that bound the test fails whatever theta is, and theta need not
     // be computed (it is never read: NaN in the history).
-    bool need_theta = size == 1 || size >= first_needed || j + 1 == max_steps;
+    bool need_theta = size == 1 || size >= first_needed || j + 1 == max_steps || decided.active;
     if (!need_theta) {
       double row_max = 0.0;
       for (int i = 0; i < size; ++i) {
@@ -278,7 +285,10 @@ double topEigenvalue(const Model& m, const cutting::Positions& X, const std::vec
     }
     if (!(b > 2e-14 * std::abs(history.back()))) makeExact(history.size() - 1);
     theta = history.back();
-    const bool last = b <= 1e-14 * std::abs(theta) || j + 1 == max_steps;
+    // Decided: theta (exact or Newton's, within ~1e-15 of the dense solver's) less a 1e-9
+    // margin is a lower bound of the value the full iteration would return.
+    const bool last = b <= 1e-14 * std::abs(theta) || j + 1 == max_steps ||
+                      (decided.active && theta > 0.0 && decided(theta * (1.0 - 1e-9)));
     if (settled || last) {
       if (size > 1) {
         eig.computeFromTridiagonal(tri_diag, tri_sub, Eigen::ComputeEigenvectors);
@@ -344,19 +354,16 @@ double topEigenvalueBound(const Model& m, const cutting::Positions& X, const std
 
 }  // namespace
 
-Status updateModelAfterCut3D(Model& model, const cutting::TetMesh& before, const cutting::TetMesh& after,
-                             const cutting::TopologyChange& change, const std::vector<std::uint8_t>& fixed_after,
-                             const std::vector<std::int32_t>& node_to_kept, const CutUpdate3DOptions& options,
-                             CutUpdate3DReport* report) {
+Status prepareModelAfterCut3D(const Model& model, const cutting::TetMesh& before, const cutting::TetMesh& after,
+                              const cutting::TopologyChange& change, const CutUpdate3DOptions& options,
+                              CutUpdate3DPrepared* prepared) {
   const int N0 = before.numNodes(), N1 = after.numNodes(), T1 = after.numTets();
+  *prepared = CutUpdate3DPrepared{};
   if (model.num_nodes != N0 || model.mass.size() != N0) return Error{"updateModelAfterCut3D: the model is not the mesh's"};
   if (static_cast<int>(change.node_old_to_new.size()) != N0 || change.new_num_nodes != N1)
     return Error{"updateModelAfterCut3D: the change does not match the meshes"};
-  if (static_cast<int>(fixed_after.size()) != N1) return Error{"updateModelAfterCut3D: fixed flags size differs from #N"};
-  if (!node_to_kept.empty() && static_cast<int>(node_to_kept.size()) != N1)
-    return Error{"updateModelAfterCut3D: node_to_kept size differs from #N"};
   const std::vector<std::int32_t>& o2n = change.node_old_to_new;
-  CutUpdate3DReport rep;
+  CutUpdate3DReport& rep = prepared->report;
   rep.omega_previous = model.omega_max;
 
   // Material of each tet.
@@ -539,13 +546,9 @@ Status updateModelAfterCut3D(Model& model, const cutting::TetMesh& before, const
     if (!(mass[j] >= 0.0) || !std::isfinite(mass[j])) return Error{"updateModelAfterCut3D: non-finite or negative mass"};
 
   // Springs: unchanged unless both ends are touched; edges between touched nodes anew.
-  struct Spring {
-    int a, b;
-    double rest, k, c;
-  };
-  // The unchanged ones stay in the model's arrays (compacted in place below, once nothing
-  // can fail); `springs` collects the recomputed ones, which follow them.
-  std::vector<Spring> springs;
+  // The unchanged ones stay in the model's arrays (compacted in place by the second part,
+  // once nothing can fail); `springs` collects the recomputed ones, which follow them.
+  std::vector<CutUpdate3DPrepared::Spring>& springs = prepared->springs;
   // Each (tet, edge) with both ends touched, sorted by (smaller node, larger node), an edge's
   // tets in increasing order (the order buildModel sums them in): two stable counting sorts,
   // by the larger node, then by the smaller.
@@ -622,6 +625,30 @@ Status updateModelAfterCut3D(Model& model, const cutting::TetMesh& before, const
       ++recomputed;
     }
   rep.springs_recomputed = recomputed;
+  prepared->num_nodes_before = N0;
+  prepared->mass = std::move(mass);
+  prepared->touched = std::move(touched);
+  prepared->region = std::move(region);
+  return Status::Ok();
+}
+
+Status finishModelAfterCut3D(Model& model, const cutting::TetMesh& after, const cutting::TopologyChange& change,
+                             const std::vector<std::uint8_t>& fixed_after, const std::vector<std::int32_t>& node_to_kept,
+                             const CutUpdate3DOptions& options, CutUpdate3DPrepared& prepared,
+                             CutUpdate3DReport* report) {
+  const int N0 = prepared.num_nodes_before, N1 = after.numNodes();
+  if (N0 < 0 || model.num_nodes != N0 || static_cast<int>(change.node_old_to_new.size()) != N0 ||
+      change.new_num_nodes != N1 || prepared.mass.size() != N1)
+    return Error{"updateModelAfterCut3D: the first part was not run for this model and cut"};
+  if (static_cast<int>(fixed_after.size()) != N1) return Error{"updateModelAfterCut3D: fixed flags size differs from #N"};
+  if (!node_to_kept.empty() && static_cast<int>(node_to_kept.size()) != N1)
+    return Error{"updateModelAfterCut3D: node_to_kept size differs from #N"};
+  const std::vector<std::int32_t>& o2n = change.node_old_to_new;
+  CutUpdate3DReport& rep = prepared.report;
+  const Eigen::VectorXd& mass = prepared.mass;
+  const std::vector<std::uint8_t>& touched = prepared.touched;
+  const std::vector<std::uint8_t>& region = prepared.region;
+  const std::vector<CutUpdate3DPrepared::Spring>& springs = prepared.springs;
 
   // Pieces cut free leave; the rest is renumbered (order kept).
   std::vector<std::int32_t> keep(node_to_kept);
@@ -667,13 +694,13 @@ Status updateModelAfterCut3D(Model& model, const cutting::TetMesh& before, const
     ++out;
   }
   Eigen::Index ns = out;
-  for (const Spring& s : springs) ns += (keep[s.a] >= 0 && keep[s.b] >= 0) ? 1 : 0;
+  for (const CutUpdate3DPrepared::Spring& s : springs) ns += (keep[s.a] >= 0 && keep[s.b] >= 0) ? 1 : 0;
   m.springs.conservativeResize(ns, 2);
   m.rest_length.conservativeResize(ns);
   m.stiffness.conservativeResize(ns);
   m.damping.conservativeResize(ns);
   for (int s = 0; s < static_cast<int>(springs.size()); ++s) {
-    const Spring& sp = springs[s];
+    const CutUpdate3DPrepared::Spring& sp = springs[s];
     if (keep[sp.a] < 0 || keep[sp.b] < 0) continue;
     m.springs(out, 0) = keep[sp.a];
     m.springs(out, 1) = keep[sp.b];
@@ -725,7 +752,22 @@ Status updateModelAfterCut3D(Model& model, const cutting::TetMesh& before, const
     carried = true;
     m.critical_dt = stabilityLimit(m.omega_max);
   };
-  auto estimate = [&]() {
+  // Whether an estimate lambda (the top eigenvalue) leads to a round of mass scaling: its
+  // own estimate (not the previous one carried) with more substeps than allowed. Monotone in
+  // lambda (sqrt, the limit and substepsFor are), so topEigenvalue may stop once its Ritz
+  // value shows it: the round that follows replaces everything that estimate sets.
+  const bool may_scale = opt.substeps <= 0 && opt.max_substeps > 0;
+  struct ScalingFollows {
+    bool active = false;
+    const std::function<bool(double)>* test = nullptr;
+    bool operator()(double lambda) const { return (*test)(lambda); }
+  };
+  const std::function<bool(double)> scaling_follows = [&](double lambda) {
+    const double omega = std::sqrt(lambda);
+    if (!rep.global_stability && !(omega >= rep.omega_previous)) return false;  // carried
+    return substepsFor(stabilityLimit(omega)) > opt.max_substeps;
+  };
+  auto estimate = [&](bool round_may_follow) {
     if (!rep.global_stability) {
       // Near the cut, an upper bound below the previous estimate settles what a Lanczos
       // estimate (a lower one) would: the previous estimate is carried over.
@@ -738,8 +780,11 @@ Status updateModelAfterCut3D(Model& model, const cutting::TetMesh& before, const
     }
     Eigen::MatrixX3d ritz;
     int steps = 0;
-    const double lambda =
-        topEigenvalue(m, X, estimate_nodes, rep.global_stability ? &mapped_mode : nullptr, options, &ritz, &steps);
+    ScalingFollows decided;
+    decided.active = options.stop_decided_estimates && may_scale && round_may_follow;
+    decided.test = &scaling_follows;
+    const double lambda = topEigenvalue(m, X, estimate_nodes, rep.global_stability ? &mapped_mode : nullptr, options,
+                                        &ritz, &steps, decided);
     rep.lanczos_steps += steps;
     rep.omega_local = std::sqrt(lambda);
     if (rep.global_stability || rep.omega_local >= rep.omega_previous) {
@@ -755,7 +800,7 @@ Status updateModelAfterCut3D(Model& model, const cutting::TetMesh& before, const
       carryPrevious();
     }
   };
-  estimate();
+  estimate(true);
   // Selective mass scaling, as buildModel, on the nodes of the estimate.
   // A carried-over previous estimate is not lowered by mass near the cut: no rounds then.
   if (opt.substeps <= 0 && opt.max_substeps > 0 && substepsFor(m.critical_dt) > opt.max_substeps && !carried) {
@@ -772,7 +817,7 @@ Status updateModelAfterCut3D(Model& model, const cutting::TetMesh& before, const
           m.inv_mass[i] = 1.0 / needed;
         }
       }
-      estimate();
+      estimate(round + 1 < 4);
       target *= 0.7;
     }
   }
@@ -787,6 +832,20 @@ Status updateModelAfterCut3D(Model& model, const cutting::TetMesh& before, const
   }
   if (report) *report = rep;
   return Status::Ok();
+}
+
+Status updateModelAfterCut3D(Model& model, const cutting::TetMesh& before, const cutting::TetMesh& after,
+                             const cutting::TopologyChange& change, const std::vector<std::uint8_t>& fixed_after,
+                             const std::vector<std::int32_t>& node_to_kept, const CutUpdate3DOptions& options,
+                             CutUpdate3DReport* report) {
+  const int N1 = after.numNodes();
+  if (static_cast<int>(fixed_after.size()) != N1) return Error{"updateModelAfterCut3D: fixed flags size differs from #N"};
+  if (!node_to_kept.empty() && static_cast<int>(node_to_kept.size()) != N1)
+    return Error{"updateModelAfterCut3D: node_to_kept size differs from #N"};
+  CutUpdate3DPrepared prepared;
+  const Status first = prepareModelAfterCut3D(model, before, after, change, options, &prepared);
+  if (!first.ok()) return first;
+  return finishModelAfterCut3D(model, after, change, fixed_after, node_to_kept, options, prepared, report);
 }
 
 }  // namespace hysim::sim

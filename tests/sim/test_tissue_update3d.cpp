@@ -245,6 +245,96 @@ TEST(TissueUpdate3D, IncrementalUpdateAfterAPartialCut) {
   EXPECT_NEAR(model.mass.sum(), built->mass.sum(), 1e-9 * built->mass.sum());
 }
 
+// The update in two parts (prepare while the pieces are searched, then finish with the kept
+// nodes) is the one-call update to the last bit; finish refuses a first part of another model.
+TEST(TissueUpdate3D, TwoPartUpdateIsTheOneCallUpdate) {
+  const cutting::TetMesh mesh = testing::boxTetMesh(6, 6, 6, 1.0);
+  auto built = modelHeldBelowHalf(mesh);
+  ASSERT_TRUE(built.ok());
+  // Cut off the top layer: its nodes leave (node_to_kept < 0), the rest is renumbered.
+  auto r = cutting::cut3d(mesh, *cutting::CutSurface::plane(Vec3(0, 0, 5.5), Vec3(0.05, 0.02, 1)));
+  ASSERT_TRUE(r.ok()) << r.error();
+  const int n = r->mesh.numNodes();
+  std::vector<std::uint8_t> fixed(static_cast<size_t>(n), 0);
+  for (int i = 0; i < n; ++i) fixed[i] = r->mesh.X(i, 2) < 0.5 ? 1 : 0;
+  std::vector<std::int32_t> keep(static_cast<size_t>(n), -1);
+  std::vector<std::uint8_t> low(static_cast<size_t>(n), 0);
+  for (int t = 0; t < r->mesh.numTets(); ++t) {
+    Eigen::Vector3d c = Eigen::Vector3d::Zero();
+    for (int k = 0; k < 4; ++k) c += r->mesh.X.row(r->mesh.T(t, k)).transpose() / 4.0;
+    if (c.z() < 5.5)
+      for (int k = 0; k < 4; ++k) low[r->mesh.T(t, k)] = 1;
+  }
+  for (int i = 0, kept = 0; i < n; ++i)
+    if (low[i]) keep[i] = kept++;
+  Model one = *built, two = *built;
+  CutUpdate3DReport rep_one, rep_two;
+  ASSERT_TRUE(updateModelAfterCut3D(one, mesh, r->mesh, r->change, fixed, keep, {}, &rep_one).ok());
+  CutUpdate3DPrepared prepared;
+  ASSERT_TRUE(prepareModelAfterCut3D(two, mesh, r->mesh, r->change, {}, &prepared).ok());
+  ASSERT_TRUE(finishModelAfterCut3D(two, r->mesh, r->change, fixed, keep, {}, prepared, &rep_two).ok());
+  EXPECT_LT(one.num_nodes, n);
+  EXPECT_EQ(one.num_nodes, two.num_nodes);
+  EXPECT_TRUE(one.mass == two.mass);
+  EXPECT_TRUE(one.springs == two.springs);
+  EXPECT_TRUE(one.stiffness == two.stiffness);
+  EXPECT_TRUE(one.damping == two.damping);
+  EXPECT_EQ(one.omega_max, two.omega_max);
+  EXPECT_EQ(one.substeps, two.substeps);
+  EXPECT_EQ(rep_one.lanczos_steps, rep_two.lanczos_steps);
+  EXPECT_EQ(rep_one.touched_nodes, rep_two.touched_nodes);
+  // A first part for another model (the cut one) is refused, and the model is left as it was.
+  Model other = *built;
+  CutUpdate3DPrepared stale;
+  ASSERT_TRUE(prepareModelAfterCut3D(other, mesh, r->mesh, r->change, {}, &stale).ok());
+  Model cut_model = one;
+  const Status refused = finishModelAfterCut3D(cut_model, r->mesh, r->change, fixed, keep, {}, stale);
+  EXPECT_FALSE(refused.ok());
+  EXPECT_NE(refused.error().find("first part"), std::string::npos) << refused.error();
+  EXPECT_EQ(cut_model.num_nodes, one.num_nodes);
+  EXPECT_TRUE(cut_model.mass == one.mass);
+}
+
+// An estimate that is followed by a round of mass scaling whatever its exact value stops as
+// soon as its Ritz value shows that: the model is the one of estimates run to convergence,
+// to the last bit, in fewer Lanczos steps.
+TEST(TissueUpdate3D, DecidedEstimatesStopEarlyWithTheSameModel) {
+  const cutting::TetMesh mesh = testing::boxTetMesh(6, 6, 6, 1.0);
+  Material mat;
+  mat.label = 1;
+  ModelOptions mo;
+  mo.max_substeps = 2;  // every update scales masses
+  std::vector<int> fixed;
+  for (int i = 0; i < mesh.numNodes(); ++i)
+    if (mesh.X(i, 2) < 0.5) fixed.push_back(i);
+  auto built = buildModel(mesh, {mat}, fixed, mo);
+  ASSERT_TRUE(built.ok());
+  // A cut close to a layer of nodes: small elements, stiff springs, mass scaling.
+  auto r = cutting::cut3d(mesh, *cutting::CutSurface::plane(Vec3(0, 0, 3.04), Vec3(0.03, 0.02, 1)));
+  ASSERT_TRUE(r.ok()) << r.error();
+  std::vector<std::uint8_t> flags(static_cast<size_t>(r->mesh.numNodes()), 0);
+  for (int i = 0; i < r->mesh.numNodes(); ++i) flags[i] = r->mesh.X(i, 2) < 0.5 ? 1 : 0;
+  for (const bool global : {false, true}) {
+    CutUpdate3DOptions full, early;
+    full.stop_decided_estimates = false;
+    if (global) full.mode_overlap = early.mode_overlap = -1.0;
+    if (global) full.max_held_estimates = early.max_held_estimates = 0;
+    Model a = *built, b = *built;
+    CutUpdate3DReport ra, rb;
+    ASSERT_TRUE(updateModelAfterCut3D(a, mesh, r->mesh, r->change, flags, {}, full, &ra).ok());
+    ASSERT_TRUE(updateModelAfterCut3D(b, mesh, r->mesh, r->change, flags, {}, early, &rb).ok());
+    EXPECT_GT(a.added_mass, built->added_mass) << "global " << global;
+    EXPECT_EQ(a.omega_max, b.omega_max) << "global " << global;
+    EXPECT_EQ(a.critical_dt, b.critical_dt);
+    EXPECT_EQ(a.substeps, b.substeps);
+    EXPECT_EQ(a.added_mass, b.added_mass);
+    EXPECT_TRUE(a.mass == b.mass);
+    EXPECT_TRUE(a.stability_mode == b.stability_mode);
+    EXPECT_EQ(a.stability_held, b.stability_held);
+    EXPECT_LT(rb.lanczos_steps, ra.lanczos_steps) << "global " << global;
+  }
+}
+
 // Global Lanczos estimate of `model` as it is (nothing changed, every node's mode "near"),
 // with the Lanczos options of `base`; *steps (optional) gets the Lanczos steps taken.
 double globalOmega(const Model& model, const cutting::TetMesh& mesh, const CutUpdate3DOptions& base = {},

@@ -115,6 +115,10 @@ struct CutUpdate3DOptions {
   // Updates in a row whose omega_max may be the previous one held as a bound after its
   // mode was near the cut (Model::stability_held); 0 = estimate over all nodes instead.
   int max_held_estimates = 4;
+  // An estimate followed by a round of mass scaling whatever its exact value (its Ritz value
+  // already needs more substeps than allowed) stops there: the round's estimate replaces it,
+  // so the model is the same to the last bit (false: every estimate runs to convergence).
+  bool stop_decided_estimates = true;
 };
 
 struct CutUpdate3DReport {
@@ -137,6 +141,31 @@ struct CutUpdate3DReport {
 Status updateModelAfterCut3D(Model& model, const cutting::TetMesh& before, const cutting::TetMesh& after,
                              const cutting::TopologyChange& change, const std::vector<std::uint8_t>& fixed_after,
                              const std::vector<std::int32_t>& node_to_kept, const CutUpdate3DOptions& options = {},
+                             CutUpdate3DReport* report = nullptr);
+
+// updateModelAfterCut3D in two parts, so that the first can run while the caller finds the
+// pieces the cut set free (it does not depend on which nodes are kept): prepare computes the
+// cut mesh's masses and the springs between touched nodes; finish drops the free pieces,
+// renumbers, updates the model in place and estimates its stability. `model` must not change
+// between the two. The same model as updateModelAfterCut3D, to the last bit.
+struct CutUpdate3DPrepared {
+  struct Spring {
+    int a, b;  // nodes of `after`
+    double rest, k, c;
+  };
+  int num_nodes_before = -1;
+  CutUpdate3DReport report;            // filled so far: masses, touched_nodes, springs_recomputed, omega_previous
+  Eigen::VectorXd mass;                // #N of after
+  std::vector<std::uint8_t> touched;   // #N of after: masses and springs between them recomputed
+  std::vector<std::uint8_t> region;    // #N of after: touched and their rings (mass region)
+  std::vector<Spring> springs;         // recomputed, in buildModel's order
+};
+Status prepareModelAfterCut3D(const Model& model, const cutting::TetMesh& before, const cutting::TetMesh& after,
+                              const cutting::TopologyChange& change, const CutUpdate3DOptions& options,
+                              CutUpdate3DPrepared* prepared);
+Status finishModelAfterCut3D(Model& model, const cutting::TetMesh& after, const cutting::TopologyChange& change,
+                             const std::vector<std::uint8_t>& fixed_after, const std::vector<std::int32_t>& node_to_kept,
+                             const CutUpdate3DOptions& options, CutUpdate3DPrepared& prepared,
                              CutUpdate3DReport* report = nullptr);
 
 }  // namespace hysim::sim
