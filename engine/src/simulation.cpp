@@ -651,12 +651,20 @@ void Simulation::finishPass() {
   if (!cut.ok()) return fail(cut.error());
   timer.lap(&rec.cut3d_ms);
   const cutting::TopologyChange& change = cut->change;
+  const cutting::TetMesh& after = cut->mesh;
+  // The first part of the tissue model's update (masses and springs around the cut) does not
+  // depend on which pieces are kept: a second thread computes it while this one finds them.
+  // It reads the model, the old and the cut mesh and the change, which nothing writes before
+  // the join below.
+  sim::CutUpdate3DPrepared model_prepared;
+  Status model_prepare_status;
+  std::jthread model_thread(
+      [&] { model_prepare_status = sim::prepareModelAfterCut3D(model_, mesh_, after, change, {}, &model_prepared); });
   rec.crossed_edges = cut->report.crossed_edges;
   rec.snapped_nodes = cut->report.snapped_nodes;
   rec.split_edges = cut->report.split_edges;
   rec.duplicated_nodes = cut->report.duplicated_nodes;
   rec.cut_faces = cut->report.cut_faces;
-  const cutting::TetMesh& after = cut->mesh;
 
   // Current positions and velocities of the new mesh: surviving nodes keep theirs (plus what
   // the cut moved them by in the rest shape); new nodes interpolate their parents.
@@ -787,6 +795,7 @@ void Simulation::finishPass() {
   std::vector<std::uint8_t> anchored_kept, kept_boundary;
   Status geometry;
   std::vector<int> kept_next;
+  std::vector<double> kept_quality;
   std::thread geometry_thread([&] {
     rest_mesh.X.resize(kept_nodes, 3);
     x_kept.resize(kept_nodes, 3);
@@ -809,6 +818,33 @@ void Simulation::finishPass() {
       kept_boundary.resize(4 * keep_tets.size());
       for (size_t k = 0; k < keep_tets.size(); ++k)
         for (int f = 0; f < 4; ++f) kept_boundary[4 * k + f] = face_next[4 * static_cast<size_t>(keep_tets[k]) + f] < 0;
+    }
+    // q_min: each element's quality is kept from the previous pass unless the element is new,
+    // renumbered onto other nodes, or has a node the cut moved (mesh_ is the old mesh until
+    // the join).
+    {
+      const auto stats_start = Clock::now();
+      kept_quality.resize(keep_tets.size());
+      std::vector<int> old_of(static_cast<size_t>(after.numTets()), -1);
+      for (int t = 0; t < static_cast<int>(change.element_old_to_new.size()); ++t) {
+        const int u = change.element_old_to_new[t];
+        if (u >= 0 && u < after.numTets()) old_of[u] = t;
+      }
+      std::vector<std::uint8_t> moved(static_cast<size_t>(n), 0);
+      for (int j : change.moved_nodes)
+        if (j >= 0 && j < n) moved[j] = 1;
+      rec.q_min = std::numeric_limits<double>::infinity();
+      for (size_t k = 0; k < keep_tets.size(); ++k) {
+        const int t = keep_tets[k], o = old_of[t];
+        bool same = o >= 0 && o < static_cast<int>(tet_quality_.size());
+        for (int c = 0; c < 4 && same; ++c) {
+          const int node = after.T(t, c);
+          same = !moved[node] && change.node_old_to_new[mesh_.T(o, c)] == node;
+        }
+        kept_quality[k] = same ? tet_quality_[o] : tetQuality(rest_mesh, static_cast<int>(k));
+        rec.q_min = std::min(rec.q_min, kept_quality[k]);
+      }
+      rec.stats_ms = std::chrono::duration<double, std::milli>(Clock::now() - stats_start).count();
     }
     geometry = buildGeometry(rest_mesh, x_kept, &rec, kept_boundary.empty() ? nullptr : &kept_boundary, &old_to_kept);
     if (face_next.empty()) return;
@@ -842,8 +878,11 @@ void Simulation::finishPass() {
   // The tissue model, updated around the cut (moment-preserving masses, Van Gelder springs,
   // stability estimate near the cut); the chips leave with their masses.
   sim::CutUpdate3DReport update;
+  model_thread.join();
   const Status model_status =
-      sim::updateModelAfterCut3D(model_, mesh_, after, change, anchored_after, new_index, {}, &update);
+      model_prepare_status.ok()
+          ? sim::finishModelAfterCut3D(model_, after, change, anchored_after, new_index, {}, model_prepared, &update)
+          : model_prepare_status;
   timer.lap(&rec.model_ms);
   geometry_thread.join();
   timer.lap(&rec.geometry_wait_ms);
@@ -851,7 +890,6 @@ void Simulation::finishPass() {
     (void)rebuildGeometry(nullptr);            // the hierarchy and locator of mesh_ again
     return fail(!model_status.ok() ? model_status.error() : geometry.error());
   }
-  const cutting::TetMesh previous = std::move(mesh_);
   mesh_ = std::move(rest_mesh);
   face_next_ = std::move(kept_next);
   anchored_ = std::move(anchored_kept);
@@ -863,39 +901,15 @@ void Simulation::finishPass() {
   timer.lap(nullptr);
   for (const ChipShape& chip : chip_shapes) chips_->addChip(chip);  // after the cavity is rebuilt
   timer.lap(&rec.chips_ms);
-  // q_min: each element's quality is kept from the previous pass unless the element is new,
-  // renumbered onto other nodes, or has a node the cut moved.
-  {
-    std::vector<double> quality(static_cast<size_t>(mesh_.numTets()));
-    std::vector<int> old_of(static_cast<size_t>(after.numTets()), -1);
-    for (int t = 0; t < static_cast<int>(change.element_old_to_new.size()); ++t) {
-      const int u = change.element_old_to_new[t];
-      if (u >= 0 && u < after.numTets()) old_of[u] = t;
-    }
-    std::vector<std::uint8_t> moved(static_cast<size_t>(n), 0);
-    for (int j : change.moved_nodes)
-      if (j >= 0 && j < n) moved[j] = 1;
-    rec.q_min = std::numeric_limits<double>::infinity();
-    for (size_t k = 0; k < keep_tets.size(); ++k) {
-      const int t = keep_tets[k], o = old_of[t];
-      bool same = o >= 0 && o < static_cast<int>(tet_quality_.size());
-      for (int c = 0; c < 4 && same; ++c) {
-        const int node = after.T(t, c);
-        same = !moved[node] && change.node_old_to_new[previous.T(o, c)] == node;
-      }
-      quality[k] = same ? tet_quality_[o] : tetQuality(mesh_, static_cast<int>(k));
-      rec.q_min = std::min(rec.q_min, quality[k]);
-    }
-    tet_quality_ = std::move(quality);
-  }
-  timer.lap(&rec.stats_ms);
+  tet_quality_ = std::move(kept_quality);
+  timer.lap(nullptr);
   rec.elements = mesh_.numTets();
   rec.nodes = mesh_.numNodes();
   rec.substeps = model_.substeps;
   rec.added_mass_g = model_.added_mass;
   rec.cut_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
   rec.other_ms = std::max(0.0, rec.cut_ms - (rec.map_ms + rec.cut3d_ms + rec.remap_ms + rec.components_ms + rec.model_ms +
-                                             rec.geometry_wait_ms + rec.chips_ms + rec.stats_ms));
+                                             rec.geometry_wait_ms + rec.chips_ms));
   passes_.push_back(rec);
   // The tet locator of the new mesh (for the buried-wire test and the next pass's map) is
   // built on a background thread after the pass, beside the steps that follow: they do not

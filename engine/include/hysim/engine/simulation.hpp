@@ -33,11 +33,13 @@ struct PassRecord {
   // cutting::cut3d, current positions of the cut mesh, free pieces found and removed (mesh
   // compacted), the tissue model (masses, springs, stability), boundary/render/contact
   // arrays, the FCL hierarchy, the tet locator, chip shapes and bodies, mesh statistics;
-  // other_ms is what is left (cut_ms minus the parts). In a pass the boundary and FCL
-  // hierarchy (surface_ms, collision_ms: that thread's wall time) are built on a second thread
-  // while this one updates the model (model_ms); geometry_wait_ms is how long this thread
-  // then waited for them (what they add to cut_ms), and other_ms is computed with
-  // geometry_wait_ms in place of those two. The tet locator (locator_ms) is built on a
+  // other_ms is what is left (cut_ms minus the parts). The model update's first part (masses
+  // and springs around the cut) runs on a second thread from the end of cut3d, beside the
+  // remap and the piece search; model_ms counts the wait for it and the second part. The
+  // mesh statistics, boundary and FCL hierarchy (stats_ms, surface_ms, collision_ms: that
+  // thread's wall time) are built on a second thread while this one updates the model
+  // (model_ms); geometry_wait_ms is how long this thread then waited for them (what they add
+  // to cut_ms), and other_ms is computed with geometry_wait_ms in place of those three. The tet locator (locator_ms) is built on a
   // background thread after the pass has ended, beside the following steps, and is not part
   // of cut_ms (at the start of a run, setTopology builds it in place); the same thread finds
   // the new mesh's distances to the anchors (for the next pass's piece search) and, when the
