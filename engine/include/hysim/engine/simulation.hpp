@@ -36,10 +36,11 @@ struct PassRecord {
   // other_ms is what is left (cut_ms minus the parts). The model update's first part (masses
   // and springs around the cut) runs on a second thread from the end of cut3d, beside the
   // remap and the piece search; model_ms counts the wait for it and the second part. The
-  // mesh statistics, boundary and FCL hierarchy (stats_ms, surface_ms, collision_ms: that
-  // thread's wall time) are built on a second thread while this one updates the model
-  // (model_ms); geometry_wait_ms is how long this thread then waited for them (what they add
-  // to cut_ms), and other_ms is computed with geometry_wait_ms in place of those three. The tet locator (locator_ms) is built on a
+  // boundary and FCL hierarchy (surface_ms, collision_ms: that thread's wall time) are then
+  // built on the same thread while this one updates the model (model_ms) and computes the
+  // mesh statistics (stats_ms); geometry_wait_ms is how long this thread then waited for them
+  // (what they add to cut_ms), and other_ms is computed with geometry_wait_ms in place of
+  // those two. The tet locator (locator_ms) is built on a
   // background thread after the pass has ended, beside the following steps, and is not part
   // of cut_ms (at the start of a run, setTopology builds it in place); the same thread finds
   // the new mesh's distances to the anchors (for the next pass's piece search) and, when the
@@ -69,6 +70,8 @@ struct PerforationEvent {
   double end_s = 0.0;            // last step of the event (still open: the latest step)
   double min_distance_mm = 0.0;  // closest approach of the wire's surface; < 0: beyond the serosa
 };
+
+class PassWorker;  // simulation.cpp
 
 class Simulation {
  public:
@@ -226,6 +229,8 @@ class Simulation {
   // that reads locator_ (the buried test, the next pass, rebuildGeometry) waits first.
   mutable std::thread locator_thread_;
   void waitLocator() const;
+  // The second thread of finishPass (made at the first pass; it sleeps between passes).
+  std::unique_ptr<PassWorker> pass_worker_;
   // anchor_distance_ and pieces_anchored_ of mesh_, face_next_ and anchored_ (cleared and
   // false when face_next_ is unknown); with count, returns the number of pieces of mesh_
   // (a whole labelling; -1: unknown), else 0.
