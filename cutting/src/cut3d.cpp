@@ -354,6 +354,19 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
   if (!input.X.allFinite()) return Error{"cut3d: non-finite node coordinates"};
   if (!(options.snap_region >= 0 && options.snap_region <= 0.5)) return Error{"cut3d: snap_region must be in [0, 0.5]"};
 
+  // Node -> tets (CSR) of the input mesh, all tets, each list ascending (see below where it is
+  // used): it reads the input only, so it is built beside the classification when options
+  // .beside lends a thread, and waited for before its first use (or any return).
+  StarLists stars;
+  std::function<void()> waitStars;
+  struct WaitOnExit {
+    std::function<void()>& wait;
+    ~WaitOnExit() {
+      if (wait) wait();
+    }
+  } waitStarsOnExit{waitStars};
+  if (options.beside) waitStars = options.beside([&input, N0, &stars] { buildStarLists(input.T, N0, &stars); });
+
   Cut3DResult result;
   TetMesh& out = result.mesh;  // written at Assemble
   Cut3DReport& report = result.report;
@@ -485,8 +498,12 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
   // neighbours, subdivision and separation at the crossed tets and the nodes on the cut); the
   // optimisation takes the lists over, patched where the cut changed tets (one O(#T) build
   // for both).
-  StarLists stars;
-  buildStarLists(input.T, N0, &stars);
+  if (waitStars) {
+    waitStars();
+    waitStars = nullptr;
+  } else {
+    buildStarLists(input.T, N0, &stars);
+  }
   const std::vector<std::int32_t>& starOff = stars.off;
   const std::vector<std::int32_t>& starTet = stars.star;
 

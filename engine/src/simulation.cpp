@@ -11,6 +11,7 @@
 #include <cmath>
 #include <condition_variable>
 #include <cstdio>
+#include <functional>
 #include <limits>
 #include <mutex>
 #include <thread>
@@ -749,6 +750,17 @@ void Simulation::finishPass() {
   }
   cutting::Cut3DOptions options;
   options.method = cutting::CutMethod::Hybrid;
+  // cut3d's work beside (its node -> tets lists) goes to the worker too.
+  std::function<void()> beside_job;
+  options.beside = [&worker, &beside_job](std::function<void()> job) -> std::function<void()> {
+    if (beside_job) {  // one job at a time in beside_job: a second runs here
+      job();
+      return [] {};
+    }
+    beside_job = std::move(job);
+    const std::int64_t ticket = worker.post(beside_job);
+    return [&worker, ticket] { worker.wait(ticket); };
+  };
   auto cut = cutting::cut3d(mesh_, *surface, options);
   if (!cut.ok()) return fail(cut.error());
   timer.lap(&rec.cut3d_ms);

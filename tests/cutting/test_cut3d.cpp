@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <limits>
 #include <random>
+#include <thread>
 
 #include "box_mesh.hpp"
 #include "hysim/cutting/cut3d.hpp"
@@ -534,6 +535,50 @@ TEST(Cut3D, BadInput) {
 // numbers), only with a tree that follows the grid: every query answers the same, bit for
 // bit, and cut3d cuts the same. The strip: a half-cylinder loop swept along a bent path,
 // with a collapsed quad (degenerate triangles, dropped by both).
+// Work handed to options.beside (run on another thread here) gives the same cut to the last
+// bit as the same work on the calling thread, also for a cut that is refused.
+TEST(Cut3D, WorkBesideGivesTheSameCut) {
+  const TetMesh box = testing::boxTetMesh(6, 6, 6, 1.0);
+  const int rows = 9, row_size = 7;
+  Positions X(rows * row_size, 3);
+  for (int r = 0; r < rows; ++r)
+    for (int i = 0; i < row_size; ++i) {
+      const double a = M_PI + M_PI * i / (row_size - 1), z = 8.0 * r / (rows - 1) - 1.0;
+      X.row(r * row_size + i) << 3.1 + 2.2 * std::cos(a) + 0.05 * z, 3.0 + 0.1 * z, 6.2 + 2.9 * std::sin(a);
+    }
+  const auto surface = CutSurface::strip(X, rows, row_size);
+  ASSERT_TRUE(surface.ok());
+  Cut3DOptions here;
+  here.method = CutMethod::Hybrid;
+  Cut3DOptions beside = here;
+  int jobs = 0;
+  std::vector<std::thread> threads;
+  beside.beside = [&](std::function<void()> job) -> std::function<void()> {
+    ++jobs;
+    threads.emplace_back(std::move(job));
+    std::thread* t = &threads.back();
+    return [t] { t->join(); };
+  };
+  threads.reserve(4);
+  const auto a = cut3d(box, *surface, here);
+  const auto b = cut3d(box, *surface, beside);
+  ASSERT_TRUE(a.ok() && b.ok()) << (a.ok() ? b.error() : a.error());
+  EXPECT_EQ(jobs, 1);
+  EXPECT_GT(a->report.cut_faces, 0);
+  EXPECT_TRUE(a->mesh.X == b->mesh.X);
+  EXPECT_TRUE(a->mesh.T == b->mesh.T);
+  EXPECT_EQ(a->change.node_old_to_new, b->change.node_old_to_new);
+  EXPECT_EQ(a->change.element_old_to_new, b->change.element_old_to_new);
+  // Refused after the job started (a mesh whose nodes all coincide): the job is waited for
+  // before the error returns.
+  TetMesh flat = box;
+  flat.X.setZero();
+  const auto refused = cut3d(flat, *surface, beside);
+  EXPECT_FALSE(refused.ok());
+  EXPECT_EQ(jobs, 2);
+  for (std::thread& t : threads) EXPECT_FALSE(t.joinable());
+}
+
 TEST(Cut3D, StripIsTheSameSurfaceAsItsTriangles) {
   const int rows = 23, row_size = 13;
   Positions X(rows * row_size, 3);

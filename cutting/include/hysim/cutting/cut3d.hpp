@@ -22,6 +22,7 @@
 //     connected;
 //  5. hybrid: local optimisation (see Optimize3DOptions).
 #include <Eigen/Core>
+#include <functional>
 #include <vector>
 
 #include "hysim/cutting/cut2d.hpp"  // CutMethod, parseCutMethod, cutMethodName
@@ -182,6 +183,10 @@ struct Cut3DOptions {
   double on_surface_tolerance = 1e-9;  // eps relative to the mesh bounding-box diagonal
   bool separate = true;             // duplicate the nodes on the cut
   Optimize3DOptions optimize;       // Hybrid only
+  // Optional: starts a job on another thread and returns what waits for it. cut3d hands it
+  // work that only reads the input mesh (its node -> tets lists), done beside the surface
+  // tests; the result is the same. Empty: everything runs on the calling thread.
+  std::function<std::function<void()>(std::function<void()>)> beside;
 };
 
 struct Cut3DReport {
