@@ -1183,6 +1183,20 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   auto collapseEdges = [&]() {
     if (!(options.collapse_fraction > 0)) return;
     std::vector<std::uint8_t> locked(N, 0);
+    // Candidates refused by a check that looks only at the stars of u and v (positions do not
+    // change here): refused again while neither star changes (starStamp[n] takes a new number
+    // whenever a tet with n dies or changes), whatever else happened. A later batch skips them
+    // (the budget check, which depends on the other collapses, never records a refusal).
+    // Per u, a list of (v, shortEdge, offCut, the two stamps) in `refusedPool`.
+    struct Refused {
+      std::int32_t v, next;
+      std::uint32_t stampU, stampV;
+      bool shortEdge, offCut;
+    };
+    std::vector<std::uint32_t> starStamp(N, 0);
+    std::uint32_t stampClock = 0;
+    std::vector<std::int32_t> refusedHead(N, -1);
+    std::vector<Refused> refusedPool;
     std::vector<std::int32_t> dying, changing, vstar, checked;
     std::vector<double> detAfter;  // per changing tet: 6 x its volume after the collapse
     std::vector<std::array<std::int32_t, 4>> keysB;
@@ -1330,6 +1344,19 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       for (const Cand& c : cands) {
         const int u = c.u, v = c.v;
         if (locked[u] || locked[v]) continue;
+        {
+          bool again = false;
+          for (std::int32_t r = refusedHead[u]; r >= 0 && !again; r = refusedPool[r].next) {
+            const Refused& e = refusedPool[r];
+            again = e.v == v && e.shortEdge == c.shortEdge && e.offCut == c.offCut && e.stampU == starStamp[u] &&
+                    e.stampV == starStamp[v];
+          }
+          if (again) continue;
+        }
+        auto refuse = [&]() {
+          refusedPool.push_back({v, refusedHead[u], starStamp[u], starStamp[v], c.shortEdge, c.offCut});
+          refusedHead[u] = static_cast<std::int32_t>(refusedPool.size()) - 1;
+        };
         // One pass over u's live tets: those with v die, the others change (u becomes v).
         // Checks in order of cost, all must pass and have no side effects (so the first
         // failure rejects, whichever it is): off the cut, one material (every live tet of u,
@@ -1391,7 +1418,10 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
             detAfter.push_back(det);
           }
         }
-        if (!ok || dying.empty()) continue;
+        if (!ok || dying.empty()) {
+          refuse();
+          continue;
+        }
         const Vec3 xv = pos(v);
         // Volume: the removed tets and the change of the others, against u's star.
         double before = 0, after = 0;
@@ -1410,9 +1440,12 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
           matAdd(t, vt, vol);
         }
         const double change = std::abs(after - before);
-        if (change > options.collapse_volume_fraction * std::max(before, refVolume) || !budget.fits(after - before) ||
-            !matFits(before))
+        // (The same decision as change > ... || !budget.fits(...) || !matFits(...): no side effects.)
+        if (change > options.collapse_volume_fraction * std::max(before, refVolume) || !matFits(before)) {
+          refuse();
           continue;
+        }
+        if (!budget.fits(after - before)) continue;
         double oldMin = 1.0;
         for (int t : dying) oldMin = std::min(oldMin, tetQ(t));
         for (int t : changing) oldMin = std::min(oldMin, tetQ(t));
@@ -1425,7 +1458,10 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
             break;
           }
         }
-        if (!ok || (c.shortEdge ? newMin < oldMin : !(newMin > oldMin))) continue;
+        if (!ok || (c.shortEdge ? newMin < oldMin : !(newMin > oldMin))) {
+          refuse();
+          continue;
+        }
         // No changed tet may coincide with a tet already around v.
         liveStar(v, vstar, nullptr);
         keysB.clear();
@@ -1443,10 +1479,16 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
           for (const auto& kb : keysB)
             if (k == kb) ok = false;
         }
-        if (!ok) continue;
+        if (!ok) {
+          refuse();
+          continue;
+        }
         // Off the cut: a boundary node only into a boundary node (an interior node's star
         // keeps its volume).
-        if (c.offCut && onBoundary(u) && !onBoundary(v)) continue;
+        if (c.offCut && onBoundary(u) && !onBoundary(v)) {
+          refuse();
+          continue;
+        }
         // Apply, check manifoldness around v and the other nodes of the removed tets, or undo.
         for (int t : dying) kill(t);
         touch(u);
@@ -1493,6 +1535,12 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
           continue;
         }
         locked[u] = locked[v] = 1;
+        // The stars that changed: of every node of the removed and changed tets (v among them), and u.
+        starStamp[u] = ++stampClock;
+        for (int t : dying)
+          for (int k = 0; k < 4; ++k) starStamp[mesh.T(t, k)] = ++stampClock;
+        for (int t : changing)
+          for (int k = 0; k < 4; ++k) starStamp[mesh.T(t, k)] = ++stampClock;
         changedTets.insert(changedTets.end(), changing.begin(), changing.end());
         budget.spend(after - before);
         ++done;
