@@ -119,7 +119,7 @@ StarShape starShape(const TetMesh& mesh, int v, const std::vector<std::int32_t>&
 
 void peelFlaps(const TetMesh& mesh, const CutRegion& region, const std::vector<std::int32_t>& seeds,
                const NodeStars& stars, const Optimize3DOptions& options, std::vector<std::uint8_t>* dead,
-               OptimizeCounts* counts) {
+               OptimizeCounts* counts, const std::function<double(int)>* quality) {
   const int N = mesh.numNodes(), M = mesh.numTets();
   if (!(options.flap_quality > 0) || seeds.empty() || N == 0 || !(region.edge_length > 0)) return;
   const double edgeTet = region.edge_length * region.edge_length * region.edge_length / (6.0 * std::sqrt(2.0));
@@ -199,7 +199,8 @@ void peelFlaps(const TetMesh& mesh, const CutRegion& region, const std::vector<s
   {
     size_t kept = 0;
     for (int t : cands) {
-      const double q = radiusRatio(pos(mesh.T(t, 0)), pos(mesh.T(t, 1)), pos(mesh.T(t, 2)), pos(mesh.T(t, 3)));
+      const double q = quality ? (*quality)(t)
+                               : radiusRatio(pos(mesh.T(t, 0)), pos(mesh.T(t, 1)), pos(mesh.T(t, 2)), pos(mesh.T(t, 3)));
       if (q < options.flap_quality) {
         cands[kept++] = t;
         candQ.push_back(q);

@@ -2067,7 +2067,8 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   if (counts) counts->onto_cut = lateSnapped;
   if (curved) {
     buildStars();  // the lists of the nodes around tets peeled above, as peelFlaps needs them
-    peelFlaps(mesh, region, seeds, stars, options, dead, counts);  // flap_peel.cpp
+    const std::function<double(int)> quality = [&](int t) { return tetQ(t); };
+    peelFlaps(mesh, region, seeds, stars, options, dead, counts, &quality);  // flap_peel.cpp
     // Tets below flap_quality that no repair removed, around a node earlier cuts left
     // non-manifold (every collapse there was refused): collapse their edges, the node
     // staying as it was.
