@@ -1180,6 +1180,15 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   // already non-manifold may stay so (see below).
   bool lastResort = false;
   std::vector<std::uint8_t> isSeed, tetChanged;  // collapseEdges: per node, per tet
+  struct Refused {
+    std::int32_t v, next;
+    std::uint32_t stampU, stampV;
+    bool shortEdge, offCut;
+  };
+  std::vector<std::uint32_t> starStamp;  // collapseEdges: see there
+  std::uint32_t stampClock = 0;
+  std::vector<std::int32_t> refusedHead, refusedUs;
+  std::vector<Refused> refusedPool;
   auto collapseEdges = [&]() {
     if (!(options.collapse_fraction > 0)) return;
     std::vector<std::uint8_t> locked(N, 0);
@@ -1188,15 +1197,12 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     // whenever a tet with n dies or changes), whatever else happened. A later batch skips them
     // (the budget check, which depends on the other collapses, never records a refusal).
     // Per u, a list of (v, shortEdge, offCut, the two stamps) in `refusedPool`.
-    struct Refused {
-      std::int32_t v, next;
-      std::uint32_t stampU, stampV;
-      bool shortEdge, offCut;
-    };
-    std::vector<std::uint32_t> starStamp(N, 0);
-    std::uint32_t stampClock = 0;
-    std::vector<std::int32_t> refusedHead(N, -1);
-    std::vector<Refused> refusedPool;
+    // (The arrays live across calls, allocated by the first: the stamps keep counting, the
+    // lists are emptied at the end of each call.)
+    if (starStamp.empty()) {
+      starStamp.assign(N, 0);
+      refusedHead.assign(N, -1);
+    }
     std::vector<std::int32_t> dying, changing, vstar, checked;
     std::vector<double> detAfter;  // per changing tet: 6 x its volume after the collapse
     std::vector<std::array<std::int32_t, 4>> keysB;
@@ -1354,6 +1360,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
           if (again) continue;
         }
         auto refuse = [&]() {
+          if (refusedHead[u] < 0) refusedUs.push_back(u);
           refusedPool.push_back({v, refusedHead[u], starStamp[u], starStamp[v], c.shortEdge, c.offCut});
           refusedHead[u] = static_cast<std::int32_t>(refusedPool.size()) - 1;
         };
@@ -1552,6 +1559,9 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       buildStars();
       std::fill(locked.begin(), locked.end(), 0);
     }
+    for (int u : refusedUs) refusedHead[u] = -1;
+    refusedUs.clear();
+    refusedPool.clear();
   };
   // Late snapping: a node off the cut but within collapse_fraction of the local edge length
   // of it, with tets whose other three nodes lie on the cut (slivers and short edges no single
