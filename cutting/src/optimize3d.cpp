@@ -361,63 +361,80 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     Vec3 unit;  // area.normalized()
   };
   std::vector<BFace> faces;
+  // The move loop changes positions only, never which tets are live or their nodes, so the
+  // boundary faces around a node, as (tet, face) in the order first seen, are the same at
+  // every call there: kept per node (bfStart[n] >= 0: bfLen[n] entries of bfPool from there).
+  // Empty bfStart: no keeping (the mesh may change between calls).
+  std::vector<std::int32_t> bfStart, bfLen;
+  std::vector<std::array<std::int32_t, 2>> bfPool;
   auto constraintOf = [&](int n) {
     Constraint c;
     faces.clear();
-    consFaces.clear();
-    // Faces by the pair of their nodes other than n (local numbers over n's neighbours).
-    nbrs.clear();
-    const std::int32_t *sBegin = starB(n), *sEnd = starE(n);
-    if (consLocal.size() < 5 * static_cast<size_t>(sEnd - sBegin)) consLocal.resize(5 * static_cast<size_t>(sEnd - sBegin));
-    std::int32_t* cl = consLocal.data();
-    for (const std::int32_t* s = sBegin; s < sEnd; ++s)
-      if (!(*dead)[*s]) {
-        *cl++ = *s;
-        for (int k = 0; k < 4; ++k) {
-          const int w = mesh.T(*s, k);
-          if (w == n) {
-            *cl++ = -1;
-            continue;
+    const bool keep = !bfStart.empty();
+    if (!keep || bfStart[n] < 0) {
+      if (!keep) bfPool.clear();
+      consFaces.clear();
+      // Faces by the pair of their nodes other than n (local numbers over n's neighbours).
+      nbrs.clear();
+      const std::int32_t *sBegin = starB(n), *sEnd = starE(n);
+      if (consLocal.size() < 5 * static_cast<size_t>(sEnd - sBegin)) consLocal.resize(5 * static_cast<size_t>(sEnd - sBegin));
+      std::int32_t* cl = consLocal.data();
+      for (const std::int32_t* s = sBegin; s < sEnd; ++s)
+        if (!(*dead)[*s]) {
+          *cl++ = *s;
+          for (int k = 0; k < 4; ++k) {
+            const int w = mesh.T(*s, k);
+            if (w == n) {
+              *cl++ = -1;
+              continue;
+            }
+            if (localId[w] < 0) {
+              localId[w] = static_cast<std::int32_t>(nbrs.size());
+              nbrs.push_back(w);
+            }
+            *cl++ = localId[w];
           }
-          if (localId[w] < 0) {
-            localId[w] = static_cast<std::int32_t>(nbrs.size());
-            nbrs.push_back(w);
+        }
+      const std::int32_t* clEnd = cl;
+      const size_t L = nbrs.size();
+      if (pairCount.size() < L * L) pairCount.assign(L * L, -1);  // index into consFaces
+      for (const std::int32_t* rec = consLocal.data(); rec < clEnd; rec += 5) {
+        const std::int32_t* lt = rec + 1;
+        int ln = 0;
+        while (lt[ln] >= 0) ++ln;
+        // The positions other than n's, p[0] < p[1] < p[2]; face f = p[r] (in f order) is the
+        // pair of the other two.
+        int p[3], np = 0;
+        for (int k = 0; k < 4; ++k)
+          if (k != ln) p[np++] = k;
+        for (int r = 0; r < 3; ++r) {
+          const std::int32_t x = lt[p[r == 0 ? 1 : 0]], y = lt[p[r == 2 ? 1 : 2]];
+          const std::int32_t key = std::min(x, y) * static_cast<std::int32_t>(L) + std::max(x, y);
+          std::int32_t& at = pairCount[key];
+          if (at >= 0) {
+            ++consFaces[at].count;
+          } else {
+            at = static_cast<std::int32_t>(consFaces.size());
+            consFaces.push_back({rec[0], p[r], 1, key});
           }
-          *cl++ = localId[w];
         }
       }
-    const std::int32_t* clEnd = cl;
-    const size_t L = nbrs.size();
-    if (pairCount.size() < L * L) pairCount.assign(L * L, -1);  // index into consFaces
-    for (const std::int32_t* rec = consLocal.data(); rec < clEnd; rec += 5) {
-      const std::int32_t* lt = rec + 1;
-      int ln = 0;
-      while (lt[ln] >= 0) ++ln;
-      // The positions other than n's, p[0] < p[1] < p[2]; face f = p[r] (in f order) is the
-      // pair of the other two.
-      int p[3], np = 0;
-      for (int k = 0; k < 4; ++k)
-        if (k != ln) p[np++] = k;
-      for (int r = 0; r < 3; ++r) {
-        const std::int32_t x = lt[p[r == 0 ? 1 : 0]], y = lt[p[r == 2 ? 1 : 2]];
-        const std::int32_t key = std::min(x, y) * static_cast<std::int32_t>(L) + std::max(x, y);
-        std::int32_t& at = pairCount[key];
-        if (at >= 0) {
-          ++consFaces[at].count;
-        } else {
-          at = static_cast<std::int32_t>(consFaces.size());
-          consFaces.push_back({rec[0], p[r], 1, key});
-        }
+      for (int w : nbrs) localId[w] = -1;
+      if (keep) bfStart[n] = static_cast<std::int32_t>(bfPool.size());
+      for (const FaceUse& fu : consFaces) {
+        pairCount[fu.key] = -1;
+        if (fu.count != 1) continue;
+        bfPool.push_back({fu.t, fu.f});
       }
+      if (keep) bfLen[n] = static_cast<std::int32_t>(bfPool.size()) - bfStart[n];
     }
-    for (int w : nbrs) localId[w] = -1;
     Vec3 sum = Vec3::Zero();
     bool boundary = false, allCut = true;
-    for (const FaceUse& fu : consFaces) {
-      pairCount[fu.key] = -1;
-      if (fu.count != 1) continue;
-      const int t = fu.t;
-      const int i0 = mesh.T(t, kFace[fu.f][0]), i1 = mesh.T(t, kFace[fu.f][1]), i2 = mesh.T(t, kFace[fu.f][2]);
+    const std::int32_t bfFrom = keep ? bfStart[n] : 0;
+    const std::int32_t bfTo = keep ? bfStart[n] + bfLen[n] : static_cast<std::int32_t>(bfPool.size());
+    for (std::int32_t bi = bfFrom; bi < bfTo; ++bi) {
+      const int t = bfPool[bi][0], f = bfPool[bi][1];
+      const int i0 = mesh.T(t, kFace[f][0]), i1 = mesh.T(t, kFace[f][1]), i2 = mesh.T(t, kFace[f][2]);
       std::int32_t o[2], m = 0;
       for (int v : {i0, i1, i2})
         if (v != n) o[m++] = v;
@@ -1872,6 +1889,9 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   std::vector<std::int32_t> movedNow;
   std::vector<double> starVolume;  // per node in the move loop, filled when first needed
   int it = 0;
+  bfStart.assign(N, -1);  // constraintOf keeps the boundary faces per node (see there)
+  bfLen.assign(N, 0);
+  bfPool.clear();
   for (; it < options.max_iterations && !work.empty(); ++it) {
     double largest = 0, scale = 0;
     movedNow.clear();
@@ -2065,6 +2085,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       break;
     }
   }
+  bfStart.clear();
   if (counts) counts->iterations = it;
   snapNear();  // moves may have made new short edges on the cut
   collapseEdges();
