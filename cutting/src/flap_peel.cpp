@@ -200,7 +200,8 @@ void peelFlaps(const TetMesh& mesh, const CutRegion& region, const std::vector<s
     size_t kept = 0;
     for (int t : cands) {
       const double q = quality ? (*quality)(t)
-                               : radiusRatio(pos(mesh.T(t, 0)), pos(mesh.T(t, 1)), pos(mesh.T(t, 2)), pos(mesh.T(t, 3)));
+                               : radiusRatio(pos(mesh.T(t, 0)), pos(mesh.T(t, 1)), pos(mesh.T(t, 2)),
+                                             pos(mesh.T(t, 3)));
       if (q < options.flap_quality) {
         cands[kept++] = t;
         candQ.push_back(q);

@@ -377,7 +377,8 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       // Faces by the pair of their nodes other than n (local numbers over n's neighbours).
       nbrs.clear();
       const std::int32_t *sBegin = starB(n), *sEnd = starE(n);
-      if (consLocal.size() < 5 * static_cast<size_t>(sEnd - sBegin)) consLocal.resize(5 * static_cast<size_t>(sEnd - sBegin));
+      const size_t recs = 5 * static_cast<size_t>(sEnd - sBegin);
+      if (consLocal.size() < recs) consLocal.resize(recs);
       std::int32_t* cl = consLocal.data();
       for (const std::int32_t* s = sBegin; s < sEnd; ++s)
         if (!(*dead)[*s]) {
