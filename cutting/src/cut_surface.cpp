@@ -1,7 +1,13 @@
 #include "hysim/cutting/cut_surface.hpp"
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
+#include <cstring>
 #include <limits>
 #include <string>
 #include <utility>
@@ -195,7 +201,35 @@ namespace {
 // AlignedBox::squaredExteriorDistance without branches (the tree walks test many boxes):
 // the same terms summed in the same order (a zero term leaves the sum unchanged), so the
 // same value bit for bit, NaN coordinates included (they add nothing).
+// (0 + a0^2 is a0^2 bit for bit: a square is +0, positive or NaN. With SSE2, x and y in one
+// register: maxpd(v, 0) is v > 0 ? v : 0 per lane, NaN included, and the sum keeps the order
+// (a0^2 + a1^2) + a2^2.)
 inline double boxDistance2(const Eigen::AlignedBox3d& box, const Eigen::Vector3d& p) {
+#if defined(__SSE2__)
+  const __m128d zero = _mm_setzero_pd();
+  const __m128d pxy = _mm_loadu_pd(p.data());
+  const __m128d below = _mm_sub_pd(_mm_loadu_pd(box.min().data()), pxy);
+  const __m128d above = _mm_sub_pd(pxy, _mm_loadu_pd(box.max().data()));
+  const __m128d aux = _mm_add_pd(_mm_max_pd(below, zero), _mm_max_pd(above, zero));
+  const __m128d sq = _mm_mul_pd(aux, aux);
+  const __m128d belowZ = _mm_sub_sd(_mm_load_sd(box.min().data() + 2), _mm_load_sd(p.data() + 2));
+  const __m128d aboveZ = _mm_sub_sd(_mm_load_sd(p.data() + 2), _mm_load_sd(box.max().data() + 2));
+  const __m128d auxZ = _mm_add_sd(_mm_max_sd(belowZ, zero), _mm_max_sd(aboveZ, zero));
+  const __m128d sum = _mm_add_sd(_mm_add_sd(sq, _mm_unpackhi_pd(sq, sq)), _mm_mul_sd(auxZ, auxZ));
+  const double dist2 = _mm_cvtsd_f64(sum);
+#ifdef HYSIM_CHECK_EXACT
+  {
+    double ref = 0;
+    for (int k = 0; k < 3; ++k) {
+      const double b = box.min()[k] - p[k], a = p[k] - box.max()[k];
+      const double x = (b > 0 ? b : 0.0) + (a > 0 ? a : 0.0);
+      ref += x * x;
+    }
+    if (std::memcmp(&ref, &dist2, sizeof dist2) != 0) std::abort();
+  }
+#endif
+  return dist2;
+#else
   double dist2 = 0;
   for (int k = 0; k < 3; ++k) {
     const double below = box.min()[k] - p[k], above = p[k] - box.max()[k];
@@ -203,6 +237,7 @@ inline double boxDistance2(const Eigen::AlignedBox3d& box, const Eigen::Vector3d
     dist2 += aux * aux;
   }
   return dist2;
+#endif
 }
 // AlignedBox::intersects for two non-empty boxes (min <= max on every axis).
 inline bool boxesMeet(const Eigen::AlignedBox3d& box, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
@@ -250,12 +285,17 @@ double CutSurface::signedDistanceNear(const Eigen::Vector3d& x, double r, Eigen:
                                  : std::numeric_limits<double>::infinity();
   int bestTri = -1, bestLeaf = -1;  // input index (for ties), place in leafTri_
   Eigen::Vector3d bestPoint = x;
+  // The stack holds each node with its box distance (computed when its parent pushed it: the
+  // same value as computing it again when popped).
   int stack[128];
+  double stackDist[128];
   int top = 0;
-  stack[top++] = 0;
+  stack[top] = 0;
+  stackDist[top++] = boxDistance2(nodes_[0].box, x);
   while (top > 0) {
-    const Node& node = nodes_[stack[--top]];
-    if (boxDistance2(node.box, x) > best) continue;  // (equal: a tie with a lower index may be there)
+    --top;
+    const Node& node = nodes_[stack[top]];
+    if (stackDist[top] > best) continue;  // (equal: a tie with a lower index may be there)
     if (node.left < 0) {
       for (int i = node.begin; i < node.end; ++i) {
         const Tri& t = leafTri_[i].t;
@@ -274,8 +314,14 @@ double CutSurface::signedDistanceNear(const Eigen::Vector3d& x, double r, Eigen:
       const double dl = boxDistance2(nodes_[node.left].box, x), dr = boxDistance2(nodes_[node.right].box, x);
       const bool leftFirst = dl <= dr;
       const double dFar = leftFirst ? dr : dl, dNear = leftFirst ? dl : dr;
-      if (dFar <= best) stack[top++] = leftFirst ? node.right : node.left;
-      if (dNear <= best) stack[top++] = leftFirst ? node.left : node.right;
+      if (dFar <= best) {
+        stack[top] = leftFirst ? node.right : node.left;
+        stackDist[top++] = dFar;
+      }
+      if (dNear <= best) {
+        stack[top] = leftFirst ? node.left : node.right;
+        stackDist[top++] = dNear;
+      }
     }
   }
   if (bestTri < 0 && std::isfinite(r)) return signedDistanceNear(x, std::numeric_limits<double>::infinity(), closest);
@@ -372,11 +418,14 @@ bool CutSurface::within(const Eigen::Vector3d& x, double r) const {
   // Boxes farther than r (with a margin for rounding) cannot hold a triangle within r.
   const double limit = r * r * (1.0 + 1e-6) + std::numeric_limits<double>::min();
   int stack[128];
+  double stackDist[128];  // (as in signedDistanceNear)
   int top = 0;
-  stack[top++] = 0;
+  stack[top] = 0;
+  stackDist[top++] = boxDistance2(nodes_[0].box, x);
   while (top > 0) {
-    const Node& node = nodes_[stack[--top]];
-    if (boxDistance2(node.box, x) > limit) continue;
+    --top;
+    const Node& node = nodes_[stack[top]];
+    if (stackDist[top] > limit) continue;
     if (node.left < 0) {
       for (int i = node.begin; i < node.end; ++i) {
         const Tri& t = leafTri_[i].t;
@@ -386,8 +435,15 @@ bool CutSurface::within(const Eigen::Vector3d& x, double r) const {
       // The nearer child first (pushed last): a hit there ends the walk sooner.
       const double dl = boxDistance2(nodes_[node.left].box, x), dr = boxDistance2(nodes_[node.right].box, x);
       const bool leftFirst = dl <= dr;
-      if ((leftFirst ? dr : dl) <= limit) stack[top++] = leftFirst ? node.right : node.left;
-      if ((leftFirst ? dl : dr) <= limit) stack[top++] = leftFirst ? node.left : node.right;
+      const double dFar = leftFirst ? dr : dl, dNear = leftFirst ? dl : dr;
+      if (dFar <= limit) {
+        stack[top] = leftFirst ? node.right : node.left;
+        stackDist[top++] = dFar;
+      }
+      if (dNear <= limit) {
+        stack[top] = leftFirst ? node.left : node.right;
+        stackDist[top++] = dNear;
+      }
     }
   }
   return false;

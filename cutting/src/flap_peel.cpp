@@ -35,6 +35,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
 #include <numeric>
 #include <vector>
@@ -118,7 +119,7 @@ StarShape starShape(const TetMesh& mesh, int v, const std::vector<std::int32_t>&
 
 void peelFlaps(const TetMesh& mesh, const CutRegion& region, const std::vector<std::int32_t>& seeds,
                const NodeStars& stars, const Optimize3DOptions& options, std::vector<std::uint8_t>* dead,
-               OptimizeCounts* counts) {
+               OptimizeCounts* counts, const std::function<double(int)>* quality) {
   const int N = mesh.numNodes(), M = mesh.numTets();
   if (!(options.flap_quality > 0) || seeds.empty() || N == 0 || !(region.edge_length > 0)) return;
   const double edgeTet = region.edge_length * region.edge_length * region.edge_length / (6.0 * std::sqrt(2.0));
@@ -179,14 +180,28 @@ void peelFlaps(const TetMesh& mesh, const CutRegion& region, const std::vector<s
   // Candidates: poor live tets around the near nodes, each once.
   std::vector<std::int32_t> cands;
   std::vector<double> candQ;
-  for (int n : nearNodes)
-    cands.insert(cands.end(), stars.begin(n), stars.end(n));
-  std::sort(cands.begin(), cands.end());
-  cands.erase(std::unique(cands.begin(), cands.end()), cands.end());
+  // (The tets of the near nodes' lists, each once, in index order: a bit per tet, set while
+  // collecting and read back word by word in index order; the same list as sorting the
+  // concatenated lists and dropping repeats.)
+  {
+    std::vector<std::uint64_t> bits(static_cast<size_t>(M) / 64 + 1, 0);
+    std::vector<std::int32_t> words;
+    for (int n : nearNodes)
+      for (const std::int32_t *s = stars.begin(n), *sEnd = stars.end(n); s < sEnd; ++s) {
+        std::uint64_t& word = bits[static_cast<size_t>(*s) >> 6];
+        if (word == 0) words.push_back(*s >> 6);
+        word |= std::uint64_t{1} << (*s & 63);
+      }
+    std::sort(words.begin(), words.end());
+    for (int wi : words)
+      for (std::uint64_t word = bits[wi]; word; word &= word - 1) cands.push_back(wi * 64 + std::countr_zero(word));
+  }
   {
     size_t kept = 0;
     for (int t : cands) {
-      const double q = radiusRatio(pos(mesh.T(t, 0)), pos(mesh.T(t, 1)), pos(mesh.T(t, 2)), pos(mesh.T(t, 3)));
+      const double q = quality ? (*quality)(t)
+                               : radiusRatio(pos(mesh.T(t, 0)), pos(mesh.T(t, 1)), pos(mesh.T(t, 2)),
+                                             pos(mesh.T(t, 3)));
       if (q < options.flap_quality) {
         cands[kept++] = t;
         candQ.push_back(q);

@@ -2,6 +2,7 @@
 // Flap peeling after a curved cut (flap_peel.cpp): thin pieces of tissue near the cut whose
 // tets are all poor are removed as a group, so that the mesh stays manifold.
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "optimize3d_internal.hpp"
@@ -44,8 +45,10 @@ struct NodeStars {
 
 // `stars` must list the live tets (those not *dead) when called; removed tets are only
 // marked in *dead.
+// `quality(t)` (optional) returns radiusRatio of tet t's four positions in its node order
+// (the optimiser's cached q*): the same value as computing it here.
 void peelFlaps(const TetMesh& mesh, const CutRegion& region, const std::vector<std::int32_t>& seeds,
                const NodeStars& stars, const Optimize3DOptions& options, std::vector<std::uint8_t>* dead,
-               OptimizeCounts* counts);
+               OptimizeCounts* counts, const std::function<double(int)>* quality = nullptr);
 
 }  // namespace hysim::cutting

@@ -361,63 +361,81 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     Vec3 unit;  // area.normalized()
   };
   std::vector<BFace> faces;
+  // The move loop changes positions only, never which tets are live or their nodes, so the
+  // boundary faces around a node, as (tet, face) in the order first seen, are the same at
+  // every call there: kept per node (bfStart[n] >= 0: bfLen[n] entries of bfPool from there).
+  // Empty bfStart: no keeping (the mesh may change between calls).
+  std::vector<std::int32_t> bfStart, bfLen;
+  std::vector<std::array<std::int32_t, 2>> bfPool;
   auto constraintOf = [&](int n) {
     Constraint c;
     faces.clear();
-    consFaces.clear();
-    // Faces by the pair of their nodes other than n (local numbers over n's neighbours).
-    nbrs.clear();
-    const std::int32_t *sBegin = starB(n), *sEnd = starE(n);
-    if (consLocal.size() < 5 * static_cast<size_t>(sEnd - sBegin)) consLocal.resize(5 * static_cast<size_t>(sEnd - sBegin));
-    std::int32_t* cl = consLocal.data();
-    for (const std::int32_t* s = sBegin; s < sEnd; ++s)
-      if (!(*dead)[*s]) {
-        *cl++ = *s;
-        for (int k = 0; k < 4; ++k) {
-          const int w = mesh.T(*s, k);
-          if (w == n) {
-            *cl++ = -1;
-            continue;
+    const bool keep = !bfStart.empty();
+    if (!keep || bfStart[n] < 0) {
+      if (!keep) bfPool.clear();
+      consFaces.clear();
+      // Faces by the pair of their nodes other than n (local numbers over n's neighbours).
+      nbrs.clear();
+      const std::int32_t *sBegin = starB(n), *sEnd = starE(n);
+      const size_t recs = 5 * static_cast<size_t>(sEnd - sBegin);
+      if (consLocal.size() < recs) consLocal.resize(recs);
+      std::int32_t* cl = consLocal.data();
+      for (const std::int32_t* s = sBegin; s < sEnd; ++s)
+        if (!(*dead)[*s]) {
+          *cl++ = *s;
+          for (int k = 0; k < 4; ++k) {
+            const int w = mesh.T(*s, k);
+            if (w == n) {
+              *cl++ = -1;
+              continue;
+            }
+            if (localId[w] < 0) {
+              localId[w] = static_cast<std::int32_t>(nbrs.size());
+              nbrs.push_back(w);
+            }
+            *cl++ = localId[w];
           }
-          if (localId[w] < 0) {
-            localId[w] = static_cast<std::int32_t>(nbrs.size());
-            nbrs.push_back(w);
+        }
+      const std::int32_t* clEnd = cl;
+      const size_t L = nbrs.size();
+      if (pairCount.size() < L * L) pairCount.assign(L * L, -1);  // index into consFaces
+      for (const std::int32_t* rec = consLocal.data(); rec < clEnd; rec += 5) {
+        const std::int32_t* lt = rec + 1;
+        int ln = 0;
+        while (lt[ln] >= 0) ++ln;
+        // The positions other than n's, p[0] < p[1] < p[2]; face f = p[r] (in f order) is the
+        // pair of the other two.
+        int p[3], np = 0;
+        for (int k = 0; k < 4; ++k)
+          if (k != ln) p[np++] = k;
+        for (int r = 0; r < 3; ++r) {
+          const std::int32_t x = lt[p[r == 0 ? 1 : 0]], y = lt[p[r == 2 ? 1 : 2]];
+          const std::int32_t key = std::min(x, y) * static_cast<std::int32_t>(L) + std::max(x, y);
+          std::int32_t& at = pairCount[key];
+          if (at >= 0) {
+            ++consFaces[at].count;
+          } else {
+            at = static_cast<std::int32_t>(consFaces.size());
+            consFaces.push_back({rec[0], p[r], 1, key});
           }
-          *cl++ = localId[w];
         }
       }
-    const std::int32_t* clEnd = cl;
-    const size_t L = nbrs.size();
-    if (pairCount.size() < L * L) pairCount.assign(L * L, -1);  // index into consFaces
-    for (const std::int32_t* rec = consLocal.data(); rec < clEnd; rec += 5) {
-      const std::int32_t* lt = rec + 1;
-      int ln = 0;
-      while (lt[ln] >= 0) ++ln;
-      // The positions other than n's, p[0] < p[1] < p[2]; face f = p[r] (in f order) is the
-      // pair of the other two.
-      int p[3], np = 0;
-      for (int k = 0; k < 4; ++k)
-        if (k != ln) p[np++] = k;
-      for (int r = 0; r < 3; ++r) {
-        const std::int32_t x = lt[p[r == 0 ? 1 : 0]], y = lt[p[r == 2 ? 1 : 2]];
-        const std::int32_t key = std::min(x, y) * static_cast<std::int32_t>(L) + std::max(x, y);
-        std::int32_t& at = pairCount[key];
-        if (at >= 0) {
-          ++consFaces[at].count;
-        } else {
-          at = static_cast<std::int32_t>(consFaces.size());
-          consFaces.push_back({rec[0], p[r], 1, key});
-        }
+      for (int w : nbrs) localId[w] = -1;
+      if (keep) bfStart[n] = static_cast<std::int32_t>(bfPool.size());
+      for (const FaceUse& fu : consFaces) {
+        pairCount[fu.key] = -1;
+        if (fu.count != 1) continue;
+        bfPool.push_back({fu.t, fu.f});
       }
+      if (keep) bfLen[n] = static_cast<std::int32_t>(bfPool.size()) - bfStart[n];
     }
-    for (int w : nbrs) localId[w] = -1;
     Vec3 sum = Vec3::Zero();
     bool boundary = false, allCut = true;
-    for (const FaceUse& fu : consFaces) {
-      pairCount[fu.key] = -1;
-      if (fu.count != 1) continue;
-      const int t = fu.t;
-      const int i0 = mesh.T(t, kFace[fu.f][0]), i1 = mesh.T(t, kFace[fu.f][1]), i2 = mesh.T(t, kFace[fu.f][2]);
+    const std::int32_t bfFrom = keep ? bfStart[n] : 0;
+    const std::int32_t bfTo = keep ? bfStart[n] + bfLen[n] : static_cast<std::int32_t>(bfPool.size());
+    for (std::int32_t bi = bfFrom; bi < bfTo; ++bi) {
+      const int t = bfPool[bi][0], f = bfPool[bi][1];
+      const int i0 = mesh.T(t, kFace[f][0]), i1 = mesh.T(t, kFace[f][1]), i2 = mesh.T(t, kFace[f][2]);
       std::int32_t o[2], m = 0;
       for (int v : {i0, i1, i2})
         if (v != n) o[m++] = v;
@@ -1180,9 +1198,29 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   // already non-manifold may stay so (see below).
   bool lastResort = false;
   std::vector<std::uint8_t> isSeed, tetChanged;  // collapseEdges: per node, per tet
+  struct Refused {
+    std::int32_t v, next;
+    std::uint32_t stampU, stampV;
+    bool shortEdge, offCut;
+  };
+  std::vector<std::uint32_t> starStamp;  // collapseEdges: see there
+  std::uint32_t stampClock = 0;
+  std::vector<std::int32_t> refusedHead, refusedUs;
+  std::vector<Refused> refusedPool;
   auto collapseEdges = [&]() {
     if (!(options.collapse_fraction > 0)) return;
     std::vector<std::uint8_t> locked(N, 0);
+    // Candidates refused by a check that looks only at the stars of u and v (positions do not
+    // change here): refused again while neither star changes (starStamp[n] takes a new number
+    // whenever a tet with n dies or changes), whatever else happened. A later batch skips them
+    // (the budget check, which depends on the other collapses, never records a refusal).
+    // Per u, a list of (v, shortEdge, offCut, the two stamps) in `refusedPool`.
+    // (The arrays live across calls, allocated by the first: the stamps keep counting, the
+    // lists are emptied at the end of each call.)
+    if (starStamp.empty()) {
+      starStamp.assign(N, 0);
+      refusedHead.assign(N, -1);
+    }
     std::vector<std::int32_t> dying, changing, vstar, checked;
     std::vector<double> detAfter;  // per changing tet: 6 x its volume after the collapse
     std::vector<std::array<std::int32_t, 4>> keysB;
@@ -1330,6 +1368,20 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       for (const Cand& c : cands) {
         const int u = c.u, v = c.v;
         if (locked[u] || locked[v]) continue;
+        {
+          bool again = false;
+          for (std::int32_t r = refusedHead[u]; r >= 0 && !again; r = refusedPool[r].next) {
+            const Refused& e = refusedPool[r];
+            again = e.v == v && e.shortEdge == c.shortEdge && e.offCut == c.offCut && e.stampU == starStamp[u] &&
+                    e.stampV == starStamp[v];
+          }
+          if (again) continue;
+        }
+        auto refuse = [&]() {
+          if (refusedHead[u] < 0) refusedUs.push_back(u);
+          refusedPool.push_back({v, refusedHead[u], starStamp[u], starStamp[v], c.shortEdge, c.offCut});
+          refusedHead[u] = static_cast<std::int32_t>(refusedPool.size()) - 1;
+        };
         // One pass over u's live tets: those with v die, the others change (u becomes v).
         // Checks in order of cost, all must pass and have no side effects (so the first
         // failure rejects, whichever it is): off the cut, one material (every live tet of u,
@@ -1391,7 +1443,10 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
             detAfter.push_back(det);
           }
         }
-        if (!ok || dying.empty()) continue;
+        if (!ok || dying.empty()) {
+          refuse();
+          continue;
+        }
         const Vec3 xv = pos(v);
         // Volume: the removed tets and the change of the others, against u's star.
         double before = 0, after = 0;
@@ -1410,9 +1465,12 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
           matAdd(t, vt, vol);
         }
         const double change = std::abs(after - before);
-        if (change > options.collapse_volume_fraction * std::max(before, refVolume) || !budget.fits(after - before) ||
-            !matFits(before))
+        // (The same decision as change > ... || !budget.fits(...) || !matFits(...): no side effects.)
+        if (change > options.collapse_volume_fraction * std::max(before, refVolume) || !matFits(before)) {
+          refuse();
           continue;
+        }
+        if (!budget.fits(after - before)) continue;
         double oldMin = 1.0;
         for (int t : dying) oldMin = std::min(oldMin, tetQ(t));
         for (int t : changing) oldMin = std::min(oldMin, tetQ(t));
@@ -1425,7 +1483,10 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
             break;
           }
         }
-        if (!ok || (c.shortEdge ? newMin < oldMin : !(newMin > oldMin))) continue;
+        if (!ok || (c.shortEdge ? newMin < oldMin : !(newMin > oldMin))) {
+          refuse();
+          continue;
+        }
         // No changed tet may coincide with a tet already around v.
         liveStar(v, vstar, nullptr);
         keysB.clear();
@@ -1443,10 +1504,16 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
           for (const auto& kb : keysB)
             if (k == kb) ok = false;
         }
-        if (!ok) continue;
+        if (!ok) {
+          refuse();
+          continue;
+        }
         // Off the cut: a boundary node only into a boundary node (an interior node's star
         // keeps its volume).
-        if (c.offCut && onBoundary(u) && !onBoundary(v)) continue;
+        if (c.offCut && onBoundary(u) && !onBoundary(v)) {
+          refuse();
+          continue;
+        }
         // Apply, check manifoldness around v and the other nodes of the removed tets, or undo.
         for (int t : dying) kill(t);
         touch(u);
@@ -1493,6 +1560,12 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
           continue;
         }
         locked[u] = locked[v] = 1;
+        // The stars that changed: of every node of the removed and changed tets (v among them), and u.
+        starStamp[u] = ++stampClock;
+        for (int t : dying)
+          for (int k = 0; k < 4; ++k) starStamp[mesh.T(t, k)] = ++stampClock;
+        for (int t : changing)
+          for (int k = 0; k < 4; ++k) starStamp[mesh.T(t, k)] = ++stampClock;
         changedTets.insert(changedTets.end(), changing.begin(), changing.end());
         budget.spend(after - before);
         ++done;
@@ -1504,6 +1577,9 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       buildStars();
       std::fill(locked.begin(), locked.end(), 0);
     }
+    for (int u : refusedUs) refusedHead[u] = -1;
+    refusedUs.clear();
+    refusedPool.clear();
   };
   // Late snapping: a node off the cut but within collapse_fraction of the local edge length
   // of it, with tets whose other three nodes lie on the cut (slivers and short edges no single
@@ -1814,6 +1890,9 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   std::vector<std::int32_t> movedNow;
   std::vector<double> starVolume;  // per node in the move loop, filled when first needed
   int it = 0;
+  bfStart.assign(N, -1);  // constraintOf keeps the boundary faces per node (see there)
+  bfLen.assign(N, 0);
+  bfPool.clear();
   for (; it < options.max_iterations && !work.empty(); ++it) {
     double largest = 0, scale = 0;
     movedNow.clear();
@@ -2007,6 +2086,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       break;
     }
   }
+  bfStart.clear();
   if (counts) counts->iterations = it;
   snapNear();  // moves may have made new short edges on the cut
   collapseEdges();
@@ -2019,7 +2099,8 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   if (counts) counts->onto_cut = lateSnapped;
   if (curved) {
     buildStars();  // the lists of the nodes around tets peeled above, as peelFlaps needs them
-    peelFlaps(mesh, region, seeds, stars, options, dead, counts);  // flap_peel.cpp
+    const std::function<double(int)> quality = [&](int t) { return tetQ(t); };
+    peelFlaps(mesh, region, seeds, stars, options, dead, counts, &quality);  // flap_peel.cpp
     // Tets below flap_quality that no repair removed, around a node earlier cuts left
     // non-manifold (every collapse there was refused): collapse their edges, the node
     // staying as it was.
