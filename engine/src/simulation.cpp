@@ -890,11 +890,11 @@ void Simulation::finishPass() {
   for (int i = 0; i < n; ++i) {
     if (new_index[i] >= 0) on_cut_[new_index[i]] = on_cut[i];
   }
-  // Meanwhile the worker (after the model's first part) compacts the kept mesh and builds its boundary, render surface
-  // and FCL hierarchy (buildGeometry), as soon as their inputs exist: they depend on the cut
-  // mesh, positions, pieces and on-cut flags only, which this thread only reads until the wait
-  // (serosa, chips, the model update), none of which depends on them, and each writes its own
-  // members, so the result is the same as one after the other.
+  // This thread compacts the kept mesh; then the worker (after the model's first part) builds
+  // its boundary, render surface and FCL hierarchy (buildGeometry): they depend on the kept
+  // mesh, positions, pieces and on-cut flags only, which this thread only reads until the
+  // wait (serosa, statistics, chips, the model update), none of which depends on them, and
+  // each writes its own members, so the result is the same as one after the other.
   // The old mesh's nodes in the kept numbering (the collision hierarchy's and the serosa's).
   std::vector<int> old_to_kept(change.node_old_to_new.size(), -1);
   for (size_t i = 0; i < change.node_old_to_new.size(); ++i) {
@@ -903,38 +903,38 @@ void Simulation::finishPass() {
   }
   // The kept mesh (rest positions, tets), its positions, velocities and anchors, and its
   // boundary: the kept tets' faces that no other tet shares (a kept tet's neighbours are in
-  // its component, so kept too), in the order cutting::boundaryFaces gives. Made on the
-  // worker (nothing on this thread reads them before the wait), which then also finds
-  // the kept mesh's face neighbours, for the next pass (a kept tet's neighbours are kept).
+  // its component, so kept too), in the order cutting::boundaryFaces gives. The worker then
+  // also finds the kept mesh's face neighbours, for the next pass (a kept tet's neighbours
+  // are kept).
   cutting::TetMesh rest_mesh;
   sim::NodeVectors x_kept, v_kept;
   std::vector<std::uint8_t> anchored_kept, kept_boundary;
   Status geometry;
   std::vector<int> kept_next;
   std::vector<double> kept_quality;
+  rest_mesh.X.resize(kept_nodes, 3);
+  x_kept.resize(kept_nodes, 3);
+  v_kept.resize(kept_nodes, 3);
+  anchored_kept.assign(static_cast<size_t>(kept_nodes), 0);
+  for (int i = 0; i < n; ++i) {
+    if (new_index[i] < 0) continue;
+    rest_mesh.X.row(new_index[i]) = rest.row(i);
+    x_kept.row(new_index[i]) = xnew.row(i);
+    v_kept.row(new_index[i]) = v.row(i);
+    anchored_kept[new_index[i]] = anchored_after[i];
+  }
+  rest_mesh.T.resize(static_cast<Eigen::Index>(keep_tets.size()), 4);
+  rest_mesh.material.resize(static_cast<Eigen::Index>(keep_tets.size()));
+  for (size_t k = 0; k < keep_tets.size(); ++k) {
+    for (int c = 0; c < 4; ++c) rest_mesh.T(static_cast<Eigen::Index>(k), c) = new_index[after.T(keep_tets[k], c)];
+    rest_mesh.material[static_cast<Eigen::Index>(k)] = after.material[keep_tets[k]];
+  }
+  if (!face_next.empty()) {
+    kept_boundary.resize(4 * keep_tets.size());
+    for (size_t k = 0; k < keep_tets.size(); ++k)
+      for (int f = 0; f < 4; ++f) kept_boundary[4 * k + f] = face_next[4 * static_cast<size_t>(keep_tets[k]) + f] < 0;
+  }
   auto geometry_job = [&] {
-    rest_mesh.X.resize(kept_nodes, 3);
-    x_kept.resize(kept_nodes, 3);
-    v_kept.resize(kept_nodes, 3);
-    anchored_kept.assign(static_cast<size_t>(kept_nodes), 0);
-    for (int i = 0; i < n; ++i) {
-      if (new_index[i] < 0) continue;
-      rest_mesh.X.row(new_index[i]) = rest.row(i);
-      x_kept.row(new_index[i]) = xnew.row(i);
-      v_kept.row(new_index[i]) = v.row(i);
-      anchored_kept[new_index[i]] = anchored_after[i];
-    }
-    rest_mesh.T.resize(static_cast<Eigen::Index>(keep_tets.size()), 4);
-    rest_mesh.material.resize(static_cast<Eigen::Index>(keep_tets.size()));
-    for (size_t k = 0; k < keep_tets.size(); ++k) {
-      for (int c = 0; c < 4; ++c) rest_mesh.T(static_cast<Eigen::Index>(k), c) = new_index[after.T(keep_tets[k], c)];
-      rest_mesh.material[static_cast<Eigen::Index>(k)] = after.material[keep_tets[k]];
-    }
-    if (!face_next.empty()) {
-      kept_boundary.resize(4 * keep_tets.size());
-      for (size_t k = 0; k < keep_tets.size(); ++k)
-        for (int f = 0; f < 4; ++f) kept_boundary[4 * k + f] = face_next[4 * static_cast<size_t>(keep_tets[k]) + f] < 0;
-    }
     geometry = buildGeometry(rest_mesh, x_kept, &rec, kept_boundary.empty() ? nullptr : &kept_boundary, &old_to_kept);
     if (face_next.empty()) return;
     if (keep_tets.size() == static_cast<size_t>(after.numTets())) {  // no piece removed
@@ -958,22 +958,6 @@ void Simulation::finishPass() {
   // The serosa follows its nodes into the new numbering.
   outer_wall_.remapNodes(old_to_kept);
   timer.lap(&rec.components_ms);
-  std::vector<ChipShape> chip_shapes;
-  if (chips_) {
-    cutting::TetMesh deformed = after;  // chips start where the pieces are now
-    deformed.X = xnew;
-    chip_shapes = chipShapes(deformed, v, comps, on_cut, scene_.materials, myoma_label);
-  }
-  timer.lap(&rec.chips_ms);
-  // The tissue model, updated around the cut (moment-preserving masses, Van Gelder springs,
-  // stability estimate near the cut); the chips leave with their masses.
-  sim::CutUpdate3DReport update;
-  worker.wait(prepare_ticket);
-  const Status model_status =
-      model_prepare_status.ok()
-          ? sim::finishModelAfterCut3D(model_, after, change, anchored_after, new_index, {}, model_prepared, &update)
-          : model_prepare_status;
-  timer.lap(&rec.model_ms);
   // q_min: each element's quality is kept from the previous pass unless the element is new,
   // renumbered onto other nodes, or has a node the cut moved (mesh_ is the old mesh until
   // the wait below). A kept tet's quality is that of its tet in `after` (the same corners in
@@ -1001,6 +985,22 @@ void Simulation::finishPass() {
     }
   }
   timer.lap(&rec.stats_ms);
+  std::vector<ChipShape> chip_shapes;
+  if (chips_) {
+    cutting::TetMesh deformed = after;  // chips start where the pieces are now
+    deformed.X = xnew;
+    chip_shapes = chipShapes(deformed, v, comps, on_cut, scene_.materials, myoma_label);
+  }
+  timer.lap(&rec.chips_ms);
+  // The tissue model, updated around the cut (moment-preserving masses, Van Gelder springs,
+  // stability estimate near the cut); the chips leave with their masses.
+  sim::CutUpdate3DReport update;
+  worker.wait(prepare_ticket);
+  const Status model_status =
+      model_prepare_status.ok()
+          ? sim::finishModelAfterCut3D(model_, after, change, anchored_after, new_index, {}, model_prepared, &update)
+          : model_prepare_status;
+  timer.lap(&rec.model_ms);
   worker.wait(geometry_ticket);
   timer.lap(&rec.geometry_wait_ms);
   if (!model_status.ok() || !geometry.ok()) {  // not reached for a valid mesh
