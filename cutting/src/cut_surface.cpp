@@ -239,6 +239,25 @@ inline double boxDistance2(const Eigen::AlignedBox3d& box, const Eigen::Vector3d
   return dist2;
 #endif
 }
+
+// The children of an inner node whose boxes lie within `limit` (squared distance) of x onto
+// the walk's stack with their box distances, the nearer last (so popped first).
+template <class Node>
+inline void pushChildren(const std::vector<Node>& nodes, const Node& node, const Eigen::Vector3d& x, double limit,
+                         int* stack, double* stackDist, int& top) {
+  const double dl = boxDistance2(nodes[node.left].box, x), dr = boxDistance2(nodes[node.right].box, x);
+  const bool leftFirst = dl <= dr;
+  const double dFar = leftFirst ? dr : dl, dNear = leftFirst ? dl : dr;
+  if (dFar <= limit) {
+    stack[top] = leftFirst ? node.right : node.left;
+    stackDist[top++] = dFar;
+  }
+  if (dNear <= limit) {
+    stack[top] = leftFirst ? node.left : node.right;
+    stackDist[top++] = dNear;
+  }
+}
+
 // AlignedBox::intersects for two non-empty boxes (min <= max on every axis).
 inline bool boxesMeet(const Eigen::AlignedBox3d& box, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
   return box.min()[0] <= hi[0] && lo[0] <= box.max()[0] && box.min()[1] <= hi[1] && lo[1] <= box.max()[1] &&
@@ -311,17 +330,7 @@ double CutSurface::signedDistanceNear(const Eigen::Vector3d& x, double r, Eigen:
       }
     } else if (top + 2 <= 128) {
       // The nearer child first (pushed last): a close triangle found early prunes the rest.
-      const double dl = boxDistance2(nodes_[node.left].box, x), dr = boxDistance2(nodes_[node.right].box, x);
-      const bool leftFirst = dl <= dr;
-      const double dFar = leftFirst ? dr : dl, dNear = leftFirst ? dl : dr;
-      if (dFar <= best) {
-        stack[top] = leftFirst ? node.right : node.left;
-        stackDist[top++] = dFar;
-      }
-      if (dNear <= best) {
-        stack[top] = leftFirst ? node.left : node.right;
-        stackDist[top++] = dNear;
-      }
+      pushChildren(nodes_, node, x, best, stack, stackDist, top);
     }
   }
   if (bestTri < 0 && std::isfinite(r)) return signedDistanceNear(x, std::numeric_limits<double>::infinity(), closest);
@@ -433,17 +442,7 @@ bool CutSurface::within(const Eigen::Vector3d& x, double r) const {
       }
     } else if (top + 2 <= 128) {
       // The nearer child first (pushed last): a hit there ends the walk sooner.
-      const double dl = boxDistance2(nodes_[node.left].box, x), dr = boxDistance2(nodes_[node.right].box, x);
-      const bool leftFirst = dl <= dr;
-      const double dFar = leftFirst ? dr : dl, dNear = leftFirst ? dl : dr;
-      if (dFar <= limit) {
-        stack[top] = leftFirst ? node.right : node.left;
-        stackDist[top++] = dFar;
-      }
-      if (dNear <= limit) {
-        stack[top] = leftFirst ? node.left : node.right;
-        stackDist[top++] = dNear;
-      }
+      pushChildren(nodes_, node, x, limit, stack, stackDist, top);
     }
   }
   return false;
