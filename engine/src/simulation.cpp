@@ -158,7 +158,7 @@ class PassWorker {
   template <class F>
   std::int64_t post(F& job) {
     const std::int64_t ticket = posted_.load(std::memory_order_relaxed);
-    if (ticket - done_.load(std::memory_order_acquire) >= kMaxJobs) {  // not reached (two jobs a pass)
+    if (ticket - done_.load(std::memory_order_acquire) >= kMaxJobs) {  // not reached (a pass has at most two outstanding)
       job();
       return -1;
     }
@@ -700,7 +700,8 @@ void Simulation::finishPass() {
   waitLocator();  // the previous pass's build, before the clock starts (see PassRecord::locator_ms)
   const auto t0 = Clock::now();
   PassTimer timer;
-  // The worker runs the model update's first part, then the geometry (below).
+  // The worker runs cut3d's node -> tets lists, the model update's first part, then the
+  // geometry (below).
   if (!pass_worker_) pass_worker_ = std::make_unique<PassWorker>();
   PassWorker& worker = *pass_worker_;
   worker.begin();
