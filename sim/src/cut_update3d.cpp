@@ -67,15 +67,14 @@ namespace {
 // the free nodes `nodes`, every other node held fixed (a principal submatrix), by Lanczos.
 // `start` (#N x 3, may be null or zero) is mixed into the deterministic start vector; `mode`
 // (#N x 3) receives the Ritz vector (zero outside `nodes`).
-// `decided(lambda)` (monotone: once true, true for every larger lambda) may end the iteration
-// early: the top Ritz value never decreases from one step to the next (T's leading block is
-// the previous T; Cauchy interlacing) and stays below the top eigenvalue, so once it is above
-// a value where `decided` holds, so is the value the full iteration would return. Then that
-// Ritz value is returned; the caller uses it only through `decided`.
-template <class Decided>
+// `decided` (may be null; monotone: once true, true for every larger lambda) may end the
+// iteration early: the top Ritz value never decreases from one step to the next (T's leading
+// block is the previous T; Cauchy interlacing) and stays below the top eigenvalue, so once
+// it is above a value where `decided` holds, so is the value the full iteration would
+// return. Then that Ritz value is returned; the caller uses it only through `decided`.
 double topEigenvalue(const Model& m, const cutting::Positions& X, const std::vector<int>& nodes,
                      const Eigen::MatrixX3d* start, const CutUpdate3DOptions& options, Eigen::MatrixX3d* mode,
-                     int* steps_taken, const Decided& decided) {
+                     int* steps_taken, const std::function<bool(double)>* decided) {
   const int count = static_cast<int>(nodes.size());
   if (steps_taken) *steps_taken = 0;
   if (count == 0) return 0.0;
@@ -236,7 +235,7 @@ double topEigenvalue(const Model& m, const cutting::Positions& X, const std::vec
     // top eigenvalue of T is at most scale * max row sum of |T / scale| (Gershgorin), so when
     // b is above 1e-14 times that bound the test fails whatever theta is, and theta need not
     // be computed (it is never read: NaN in the history).
-    bool need_theta = size == 1 || size >= first_needed || j + 1 == max_steps || decided.active;
+    bool need_theta = size == 1 || size >= first_needed || j + 1 == max_steps || decided != nullptr;
     if (!need_theta) {
       double row_max = 0.0;
       for (int i = 0; i < size; ++i) {
@@ -288,7 +287,7 @@ double topEigenvalue(const Model& m, const cutting::Positions& X, const std::vec
     // Decided: theta (exact or Newton's, within ~1e-15 of the dense solver's) less a 1e-9
     // margin is a lower bound of the value the full iteration would return.
     const bool last = b <= 1e-14 * std::abs(theta) || j + 1 == max_steps ||
-                      (decided.active && theta > 0.0 && decided(theta * (1.0 - 1e-9)));
+                      (decided != nullptr && theta > 0.0 && (*decided)(theta * (1.0 - 1e-9)));
     if (settled || last) {
       if (size > 1) {
         eig.computeFromTridiagonal(tri_diag, tri_sub, Eigen::ComputeEigenvectors);
@@ -757,11 +756,6 @@ Status finishModelAfterCut3D(Model& model, const cutting::TetMesh& after, const 
   // lambda (sqrt, the limit and substepsFor are), so topEigenvalue may stop once its Ritz
   // value shows it: the round that follows replaces everything that estimate sets.
   const bool may_scale = opt.substeps <= 0 && opt.max_substeps > 0;
-  struct ScalingFollows {
-    bool active = false;
-    const std::function<bool(double)>* test = nullptr;
-    bool operator()(double lambda) const { return (*test)(lambda); }
-  };
   const std::function<bool(double)> scaling_follows = [&](double lambda) {
     const double omega = std::sqrt(lambda);
     if (!rep.global_stability && !(omega >= rep.omega_previous)) return false;  // carried
@@ -780,11 +774,9 @@ Status finishModelAfterCut3D(Model& model, const cutting::TetMesh& after, const 
     }
     Eigen::MatrixX3d ritz;
     int steps = 0;
-    ScalingFollows decided;
-    decided.active = options.stop_decided_estimates && may_scale && round_may_follow;
-    decided.test = &scaling_follows;
+    const bool stop_early = options.stop_decided_estimates && may_scale && round_may_follow;
     const double lambda = topEigenvalue(m, X, estimate_nodes, rep.global_stability ? &mapped_mode : nullptr, options,
-                                        &ritz, &steps, decided);
+                                        &ritz, &steps, stop_early ? &scaling_follows : nullptr);
     rep.lanczos_steps += steps;
     rep.omega_local = std::sqrt(lambda);
     if (rep.global_stability || rep.omega_local >= rep.omega_previous) {
@@ -838,11 +830,7 @@ Status updateModelAfterCut3D(Model& model, const cutting::TetMesh& before, const
                              const cutting::TopologyChange& change, const std::vector<std::uint8_t>& fixed_after,
                              const std::vector<std::int32_t>& node_to_kept, const CutUpdate3DOptions& options,
                              CutUpdate3DReport* report) {
-  const int N1 = after.numNodes();
-  if (static_cast<int>(fixed_after.size()) != N1) return Error{"updateModelAfterCut3D: fixed flags size differs from #N"};
-  if (!node_to_kept.empty() && static_cast<int>(node_to_kept.size()) != N1)
-    return Error{"updateModelAfterCut3D: node_to_kept size differs from #N"};
-  CutUpdate3DPrepared prepared;
+  CutUpdate3DPrepared prepared;  // (the first part leaves the model as it is)
   const Status first = prepareModelAfterCut3D(model, before, after, change, options, &prepared);
   if (!first.ok()) return first;
   return finishModelAfterCut3D(model, after, change, fixed_after, node_to_kept, options, prepared, report);
