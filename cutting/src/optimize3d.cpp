@@ -288,8 +288,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   auto tetQAt = [&](int t, int n, const Vec3& y) {
     Vec3 p[4];
     for (int k = 0; k < 4; ++k) p[k] = mesh.T(t, k) == n ? y : pos(mesh.T(t, k));
-    if (!((p[1] - p[0]).dot((p[2] - p[0]).cross(p[3] - p[0])) > 0)) return -1.0;
-    return radiusRatio(p[0], p[1], p[2], p[3]);
+    return radiusRatioOriented(p[0], p[1], p[2], p[3]);  // -1 where not (p1-p0).((p2-p0)x(p3-p0)) > 0
   };
   // Worst q* around n where it is (tetQAt at its own position, through the cache).
   auto starWorst = [&](int n, int* worstTet) {
@@ -826,7 +825,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       return (pos(b) - p0).dot((pos(c) - p0).cross(pos(d) - p0));
     };
     auto q4 = [&](int a, int b, int c, int d) {
-      return vol6(a, b, c, d) > 0 ? radiusRatio(pos(a), pos(b), pos(c), pos(d)) : -1.0;
+      return radiusRatioOriented(pos(a), pos(b), pos(c), pos(d));  // -1 unless vol6(a, b, c, d) > 0
     };
     auto setTet = [&](int t, int a, int b, int c, int d) {
       flipChanged.push_back(t);
