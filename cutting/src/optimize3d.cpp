@@ -687,8 +687,24 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
         }
       frontier.swap(next);
     }
-    std::sort(seeds.begin() + static_cast<std::ptrdiff_t>(region.seeds.size()), seeds.end());
-    seeds.erase(std::unique(seeds.begin() + static_cast<std::ptrdiff_t>(region.seeds.size()), seeds.end()), seeds.end());
+    // The added seeds sorted, without repeats (as sort + unique): a bit per node, read back
+    // word by word in index order (as regionTets).
+    const size_t base = region.seeds.size();
+    if (seeds.size() > base) {
+      std::vector<std::uint64_t> nodeBits(static_cast<size_t>(N) / 64 + 1, 0);
+      std::vector<std::int32_t> words;
+      for (size_t i = base; i < seeds.size(); ++i) {
+        const int v = seeds[i];
+        std::uint64_t& word = nodeBits[static_cast<size_t>(v) >> 6];
+        if (word == 0) words.push_back(v >> 6);
+        word |= std::uint64_t{1} << (v & 63);
+      }
+      std::sort(words.begin(), words.end());
+      seeds.resize(base);
+      for (int wi : words)
+        for (std::uint64_t word = nodeBits[wi]; word; word &= word - 1)
+          seeds.push_back(wi * 64 + std::countr_zero(word));
+    }
   }
   // The live tets around the seeds, each once, in index order.
   // A bit per tet: set while collecting, read back word by word (index order), cleared.
