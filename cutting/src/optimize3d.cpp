@@ -155,7 +155,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     killed.push_back(t);
     for (int k = 0; k < 4; ++k) touch(mesh.T(t, k));
   };
-  std::vector<std::int32_t> scratch;
+  std::vector<std::int32_t> scratch, scratch2;
   auto buildStars = [&]() {
     if (!built) {
       built = true;
@@ -175,10 +175,15 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       scratch.assign(starB(n), starE(n));
       auto g = std::lower_bound(gained.begin(), gained.end(), std::make_pair(static_cast<std::int32_t>(n), std::int32_t{-1}));
       // (A list is sorted and without repeats: a node that gained no tet needs no sort.)
+      // (Both runs are sorted, the gained tets as `gained` is: merged, as a sort of the whole.)
       if (g != gained.end() && g->first == n) {
+        const size_t mid = scratch.size();
         for (; g != gained.end() && g->first == n; ++g) scratch.push_back(g->second);
-        std::sort(scratch.begin(), scratch.end());
-        scratch.erase(std::unique(scratch.begin(), scratch.end()), scratch.end());
+        scratch2.clear();
+        std::merge(scratch.begin(), scratch.begin() + static_cast<std::ptrdiff_t>(mid),
+                   scratch.begin() + static_cast<std::ptrdiff_t>(mid), scratch.end(), std::back_inserter(scratch2));
+        scratch2.erase(std::unique(scratch2.begin(), scratch2.end()), scratch2.end());
+        scratch.swap(scratch2);
       }
 #ifdef HYSIM_CHECK_EXACT
       if (std::adjacent_find(scratch.begin(), scratch.end(), std::greater_equal<std::int32_t>()) != scratch.end())
@@ -823,7 +828,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     };
     failedPrev.clear();
     failedNow.clear();
-    std::vector<std::int32_t> cands, edgeAll;
+    std::vector<std::int32_t> cands, candsMerged, edgeAll;
     // The live tets around t's nodes 0, 1 and 2 (star order; t among them), each with, per
     // position l (4 bits each), the mask of t's nodes equal to its node l: the face and edge
     // searches below read them instead of scanning the stars again. hitsOf(m, S): how many
@@ -866,9 +871,24 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
           flipSeeds.assign(seeds.begin(), seeds.end());
           std::sort(flipSeeds.begin(), flipSeeds.end());
         }
-        cands.insert(cands.end(), flipChanged.begin(), flipChanged.end());
-        std::sort(cands.begin(), cands.end());
-        cands.erase(std::unique(cands.begin(), cands.end()), cands.end());
+        // (cands is sorted and without repeats: the changed tets sorted and merged in, as a
+        // sort + unique of the whole.)
+#ifdef HYSIM_CHECK_EXACT
+        std::vector<std::int32_t> ref(cands);
+        ref.insert(ref.end(), flipChanged.begin(), flipChanged.end());
+        std::sort(ref.begin(), ref.end());
+        ref.erase(std::unique(ref.begin(), ref.end()), ref.end());
+        if (std::adjacent_find(cands.begin(), cands.end(), std::greater_equal<std::int32_t>()) != cands.end())
+          std::abort();
+#endif
+        std::sort(flipChanged.begin(), flipChanged.end());
+        candsMerged.clear();
+        std::merge(cands.begin(), cands.end(), flipChanged.begin(), flipChanged.end(), std::back_inserter(candsMerged));
+        candsMerged.erase(std::unique(candsMerged.begin(), candsMerged.end()), candsMerged.end());
+        cands.swap(candsMerged);
+#ifdef HYSIM_CHECK_EXACT
+        if (ref != cands) std::abort();
+#endif
         cands.erase(std::remove_if(cands.begin(), cands.end(),
                                    [&](int t) {
                                      if ((*dead)[t]) return true;
@@ -1667,7 +1687,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
         if (d < limit) cands.emplace_back(d, u);
       }
     std::sort(cands.begin(), cands.end());
-    std::vector<std::int32_t> dying, changing, group, tets;
+    std::vector<std::int32_t> dying, changing, group, tets, tetsMerged;
     std::vector<Vec3> targets, groupTo, groupFrom;
     std::vector<std::uint64_t> targetEdges;
     std::vector<std::uint32_t> groupVer;
@@ -1683,12 +1703,32 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     // checks; otherwise leaves everything as it was and names a near node (not on the cut, not
     // in the group) of the tet that failed, if there is one.
     auto trySnap = [&](int* partner) {
+      // The live tets of the group's stars, sorted, each once: each star is sorted, so a
+      // merge of the runs (one node: its star as it is) gives what sort + unique gave.
       tets.clear();
-      for (int g : group)
-        for (const std::int32_t *s = starB(g), *sEnd = starE(g); s < sEnd; ++s)
+      for (size_t gi = 0; gi < group.size(); ++gi) {
+        const size_t mid = tets.size();
+        for (const std::int32_t *s = starB(group[gi]), *sEnd = starE(group[gi]); s < sEnd; ++s)
           if (!(*dead)[(*s)]) tets.push_back((*s));
-      std::sort(tets.begin(), tets.end());
-      tets.erase(std::unique(tets.begin(), tets.end()), tets.end());
+        if (gi > 0) {
+          tetsMerged.clear();
+          std::merge(tets.begin(), tets.begin() + static_cast<std::ptrdiff_t>(mid),
+                     tets.begin() + static_cast<std::ptrdiff_t>(mid), tets.end(), std::back_inserter(tetsMerged));
+          tetsMerged.erase(std::unique(tetsMerged.begin(), tetsMerged.end()), tetsMerged.end());
+          tets.swap(tetsMerged);
+        }
+      }
+#ifdef HYSIM_CHECK_EXACT
+      {
+        std::vector<std::int32_t> ref;
+        for (int g : group)
+          for (const std::int32_t *s = starB(g), *sEnd = starE(g); s < sEnd; ++s)
+            if (!(*dead)[(*s)]) ref.push_back((*s));
+        std::sort(ref.begin(), ref.end());
+        ref.erase(std::unique(ref.begin(), ref.end()), ref.end());
+        if (ref != tets) std::abort();
+      }
+#endif
       dying.clear();
       changing.clear();
       double oldMin = 1.0, newMin = 1.0, before = 0, after = 0;
