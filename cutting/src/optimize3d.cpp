@@ -37,6 +37,9 @@
 #include <iterator>
 #include <limits>
 #include <vector>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 #include "hysim/cutting/cut3d.hpp"
 #include "hysim/cutting/mesh_stats.hpp"
@@ -927,6 +930,10 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
         nearTets.clear();
         {
           const int t0 = mesh.T(t, 0), t1 = mesh.T(t, 1), t2 = mesh.T(t, 2), t3 = mesh.T(t, 3);
+#if defined(__SSE2__)
+          // (Bit l of lane k: node l of the tet equals t's node k, four compares at once.)
+          const __m128i tNodes = _mm_set_epi32(t3, t2, t1, t0);
+#endif
           for (int i = 0; i < 3; ++i) {
             nearOff[i] = static_cast<int>(nearTets.size());
             for (const std::int32_t *s = starB(mesh.T(t, i)), *sEnd = starE(mesh.T(t, i)); s < sEnd; ++s) {
@@ -934,7 +941,13 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
               unsigned m = 0;
               for (int l = 0; l < 4; ++l) {
                 const int w = mesh.T(*s, l);
+#if defined(__SSE2__)
+                const unsigned eq = static_cast<unsigned>(
+                    _mm_movemask_ps(_mm_castsi128_ps(_mm_cmpeq_epi32(_mm_set1_epi32(w), tNodes))));
+                m |= eq << (4 * l);
+#else
                 m |= (unsigned(w == t0) | unsigned(w == t1) << 1 | unsigned(w == t2) << 2 | unsigned(w == t3) << 3) << (4 * l);
+#endif
               }
               nearTets.push_back({*s, static_cast<std::uint16_t>(m)});
             }
