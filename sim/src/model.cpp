@@ -250,13 +250,16 @@ State makeState(const Model& model, const TetMesh& mesh) {
   const int n = model.num_nodes;
   s.x = mesh.X;
   s.v = NodeVectors::Zero(n, 3);
+  // f stays zero at anchored nodes (the symplectic step writes free rows only); the
+  // integrators' scratch arrays and the spring forces are written before they are read in
+  // every step, so they are only sized (as the simulator's resetState does).
   s.f = NodeVectors::Zero(n, 3);
-  s.scratch0 = NodeVectors::Zero(n, 3);
-  s.scratch1 = NodeVectors::Zero(n, 3);
-  s.scratch2 = NodeVectors::Zero(n, 3);
-  s.spring_force = Eigen::MatrixX3d::Zero(model.step_springs.size(), 3);
-  s.solve0 = Eigen::MatrixX3d::Zero(n, 3);
-  s.solve1 = Eigen::MatrixX3d::Zero(n, 3);
+  s.scratch0.resize(n, 3);
+  s.scratch1.resize(n, 3);
+  s.scratch2.resize(n, 3);
+  s.spring_force.resize(model.step_springs.size(), 3);
+  s.solve0.resize(n, 3);
+  s.solve1.resize(n, 3);
   return s;
 }
 
