@@ -127,8 +127,23 @@ double topEigenvalue(const Model& m, const cutting::Positions& X, const std::vec
   if (steps_taken) *steps_taken = 0;
   if (count == 0) return 0.0;
   const StepSprings& st = m.step_springs;
-  std::vector<int> local(static_cast<size_t>(m.num_nodes), -1);
+  // Scratch kept between calls (per thread): `local` is all -1 between calls (reset below).
+  struct Scratch {
+    std::vector<int> local;
+    std::vector<FreeSpring4> springs4;
+    std::vector<double> held_block, cols, u4, z4;
+  };
+  thread_local Scratch scratch;
+  std::vector<int>& local = scratch.local;
+  if (local.size() < static_cast<size_t>(m.num_nodes)) local.resize(static_cast<size_t>(m.num_nodes), -1);
   for (int k = 0; k < count; ++k) local[nodes[k]] = k;
+  struct ResetLocal {
+    std::vector<int>& local;
+    const std::vector<int>& nodes;
+    ~ResetLocal() {
+      for (int node : nodes) local[node] = -1;
+    }
+  } reset_local{local, nodes};
   // The operator, with y = M^-1/2 u: a spring between free nodes contributes t = k d.(y_b - y_a)
   // to z_b along d and its negative to z_a; with w = sqrt(k) d / sqrt(m) at each end that is
   // t = w_b.u_b - w_a.u_a, z_a -= t w_a, z_b += t w_b. A spring to a held node (y = 0 there)
@@ -138,12 +153,15 @@ double topEigenvalue(const Model& m, const cutting::Positions& X, const std::vec
     double wa[3], wb[3];
   };
   std::vector<FreeSpring> springs;
-  std::vector<FreeSpring4> springs4;  // the AVX2 form
+  std::vector<FreeSpring4>& springs4 = scratch.springs4;  // the AVX2 form
+  springs4.clear();
   const bool avx2 = m.options.simd && lanczosAvx2();
-  (avx2 ? springs4.reserve(static_cast<size_t>(count) * 7) : springs.reserve(static_cast<size_t>(count) * 7));
-  std::vector<double> held_block(6 * static_cast<size_t>(count), 0.0);  // xx yy zz xy yz zx
+  if (!avx2) springs.reserve(static_cast<size_t>(count) * 7);
+  std::vector<double>& held_block = scratch.held_block;  // xx yy zz xy yz zx per node, zeroed at its turn
+  if (held_block.size() < 6 * static_cast<size_t>(count)) held_block.resize(6 * static_cast<size_t>(count));
   for (int k = 0; k < count; ++k) {
     const int node = nodes[k];
+    std::fill_n(&held_block[6 * static_cast<size_t>(k)], 6, 0.0);  // only node k's own turn adds to it
     for (int e = st.node_offset[node]; e < st.node_offset[node + 1]; ++e) {
       const int s = st.incident[e];
       const int a = st.a[s], b = st.b[s];
@@ -188,11 +206,13 @@ double topEigenvalue(const Model& m, const cutting::Positions& X, const std::vec
     }
   }
   const Eigen::Index n3 = 3 * static_cast<Eigen::Index>(count);
-  std::vector<double> cols, u4, z4;
+  std::vector<double>& cols = scratch.cols;
+  std::vector<double>& u4 = scratch.u4;
+  std::vector<double>& z4 = scratch.z4;
   if (avx2) {
-    cols.resize(12 * static_cast<size_t>(count));
-    u4.resize(4 * static_cast<size_t>(count));
-    z4.resize(4 * static_cast<size_t>(count));
+    if (cols.size() < 12 * static_cast<size_t>(count)) cols.resize(12 * static_cast<size_t>(count));
+    if (u4.size() < 4 * static_cast<size_t>(count)) u4.resize(4 * static_cast<size_t>(count));
+    if (z4.size() < 4 * static_cast<size_t>(count)) z4.resize(4 * static_cast<size_t>(count));
     for (int k = 0; k < count; ++k) {
       const double* h = &held_block[6 * static_cast<size_t>(k)];
       double* c = &cols[12 * static_cast<size_t>(k)];
