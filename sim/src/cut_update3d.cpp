@@ -778,13 +778,24 @@ Status finishModelAfterCut3D(Model& model, const cutting::TetMesh& after, const 
   for (int i = 0; i < N2; ++i)
     if (!m.fixed[i]) m.inv_mass[i] = 1.0 / m.mass[i];
   // Unchanged springs, compacted in place (a row is read before any row at or above it is
-  // written), then the recomputed ones: the order of a full copy.
+  // written), then the recomputed ones: the order of a full copy. buildStepSprings's counting
+  // pass on the way.
+  std::vector<std::int32_t>& step_offset = m.step_springs.node_offset;
+  step_offset.assign(static_cast<size_t>(N2) + 1, 0);
+  int step_count = 0;
+  auto countStep = [&](int a, int b) {
+    if (m.fixed[a] && m.fixed[b]) return;
+    ++step_count;
+    ++step_offset[a + 1];
+    ++step_offset[b + 1];
+  };
   Eigen::Index out = 0;
   for (Eigen::Index s = 0; s < m.springs.rows(); ++s) {
     const int a = o2n[m.springs(s, 0)], b = o2n[m.springs(s, 1)];
     if (a < 0 || b < 0 || (touched[a] && touched[b]) || keep[a] < 0 || keep[b] < 0) continue;
     m.springs(out, 0) = keep[a];
     m.springs(out, 1) = keep[b];
+    countStep(keep[a], keep[b]);
     m.rest_length[out] = m.rest_length[s];
     m.stiffness[out] = m.stiffness[s];
     m.damping[out] = m.damping[s];
@@ -801,12 +812,13 @@ Status finishModelAfterCut3D(Model& model, const cutting::TetMesh& after, const 
     if (keep[sp.a] < 0 || keep[sp.b] < 0) continue;
     m.springs(out, 0) = keep[sp.a];
     m.springs(out, 1) = keep[sp.b];
+    countStep(keep[sp.a], keep[sp.b]);
     m.rest_length[out] = sp.rest;
     m.stiffness[out] = sp.k;
     m.damping[out] = sp.c;
     ++out;
   }
-  buildStepSprings(m);
+  fillStepSprings(m, step_count);
   cutting::Positions X(N2, 3);
   for (int i = 0; i < N1; ++i)
     if (keep[i] >= 0) X.row(keep[i]) = after.X.row(i);
