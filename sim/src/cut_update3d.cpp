@@ -6,6 +6,7 @@
 #include <functional>
 #include <immintrin.h>
 #include <limits>
+#include <memory>
 #include <string>
 
 #include "hysim/sim/tissue_update3d.hpp"
@@ -478,7 +479,10 @@ Status prepareModelAfterCut3D(const Model& model, const cutting::TetMesh& before
                    " but the scene defines no material with that label"};
   }
   // Tets around each node (CSR).
-  std::vector<int> off(static_cast<size_t>(N1) + 1, 0), around(4 * static_cast<size_t>(T1));
+  // (`around` is written in full below: allocated without zero-filling it first.)
+  std::vector<int> off(static_cast<size_t>(N1) + 1, 0);
+  const std::unique_ptr<int[]> around_storage(new int[4 * static_cast<size_t>(T1)]);
+  int* const around = around_storage.get();
   for (int t = 0; t < T1; ++t)
     for (int k = 0; k < 4; ++k) ++off[after.T(t, k) + 1];
   for (int i = 0; i < N1; ++i) off[i + 1] += off[i];
