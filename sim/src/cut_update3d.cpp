@@ -112,6 +112,32 @@ bool lanczosAvx2() {
   for (int k = 0; k < count; ++k) _mm256_maskstore_pd(z + 3 * k, three, _mm256_loadu_pd(z4 + 4 * k));
 }
 
+// The elements t of `after` that are not the old element old_of[t] with the same nodes in the
+// same order (o2n[before.T(old_of[t], k)] == after.T(t, k), k = 0..3), 4 at a time (and the
+// last T1 % 4 whatever they are), into `out` in increasing order; returns their number.
+[[gnu::target("avx2")]] int sameOrderCandidatesAvx2(int T1, const int* old_of, const std::int32_t* const after_col[4],
+                                                    const std::int32_t* const before_col[4], const std::int32_t* o2n,
+                                                    int* out) {
+  int n = 0, t = 0;
+  const __m128i minus1 = _mm_set1_epi32(-1);
+  for (; t + 4 <= T1; t += 4) {
+    const __m128i o = _mm_loadu_si128(reinterpret_cast<const __m128i*>(old_of + t));
+    const __m128i valid = _mm_cmpgt_epi32(o, minus1);
+    __m128i same = valid;
+    for (int c = 0; c < 4; ++c) {
+      const __m128i node = _mm_mask_i32gather_epi32(_mm_setzero_si128(), before_col[c], o, valid, 4);
+      const __m128i renumbered = _mm_mask_i32gather_epi32(minus1, o2n, node, valid, 4);
+      same = _mm_and_si128(same, _mm_cmpeq_epi32(renumbered, _mm_loadu_si128(reinterpret_cast<const __m128i*>(after_col[c] + t))));
+    }
+    const int bits = _mm_movemask_ps(_mm_castsi128_ps(same));
+    if (bits != 0xF)
+      for (int i = 0; i < 4; ++i)
+        if (!((bits >> i) & 1)) out[n++] = t + i;
+  }
+  for (; t < T1; ++t) out[n++] = t;
+  return n;
+}
+
 // Top eigenvalue of M^-1/2 K M^-1/2 (springs linearised along their rest directions) over
 // the free nodes `nodes`, every other node held fixed (a principal submatrix), by Lanczos.
 // `start` (#N x 3, may be null or zero) is mixed into the deterministic start vector; `mode`
@@ -534,11 +560,11 @@ Status prepareModelAfterCut3D(const Model& model, const cutting::TetMesh& before
                                        after.T.col(3).data()};
   const std::int32_t* before_col[4] = {before.T.col(0).data(), before.T.col(1).data(), before.T.col(2).data(),
                                         before.T.col(3).data()};
-  for (int t = 0; t < T1; ++t) {
+  auto compareElement = [&](int t) {
     const int o = old_of[t];
     if (o >= 0 && after_col[0][t] == o2n[before_col[0][o]] && after_col[1][t] == o2n[before_col[1][o]] &&
         after_col[2][t] == o2n[before_col[2][o]] && after_col[3][t] == o2n[before_col[3][o]])
-      continue;  // the same nodes in the same order: most elements
+      return;  // the same nodes in the same order: most elements
     bool same = o >= 0;
     if (same) {
       std::array<int, 4> a{}, b{};
@@ -556,6 +582,15 @@ Status prepareModelAfterCut3D(const Model& model, const cutting::TetMesh& before
       touchTet(t);
       if (o >= 0) touchOld(o);
     }
+  };
+  if (model.options.simd && lanczosAvx2() && T1 > 0) {
+    // The first test (same nodes in the same order) 4 elements at a time; the others as above.
+    const std::unique_ptr<int[]> candidates(new int[static_cast<size_t>(T1)]);
+    const int num_candidates =
+        sameOrderCandidatesAvx2(T1, old_of.data(), after_col, before_col, o2n.data(), candidates.get());
+    for (int i = 0; i < num_candidates; ++i) compareElement(candidates[i]);
+  } else {
+    for (int t = 0; t < T1; ++t) compareElement(t);
   }
   for (int t : change.added_elements)
     if (t >= 0 && t < T1) touchTet(t);
@@ -793,17 +828,32 @@ Status finishModelAfterCut3D(Model& model, const cutting::TetMesh& after, const 
     ++step_offset[a + 1];
     ++step_offset[b + 1];
   };
+  // Each old node's fate in one lookup per spring end: 2 * its kept index + (touched ? 1 : 0),
+  // or -1 when it is gone (cut away or in a removed piece).
+  const std::unique_ptr<std::int32_t[]> fate(new std::int32_t[static_cast<size_t>(std::max(N0, 1))]);
+  for (int i = 0; i < N0; ++i) {
+    const int j = o2n[i];
+    fate[i] = j < 0 || keep[j] < 0 ? -1 : 2 * keep[j] + (touched[j] ? 1 : 0);
+  }
   Eigen::Index out = 0;
-  for (Eigen::Index s = 0; s < m.springs.rows(); ++s) {
-    const int a = o2n[m.springs(s, 0)], b = o2n[m.springs(s, 1)];
-    if (a < 0 || b < 0 || (touched[a] && touched[b]) || keep[a] < 0 || keep[b] < 0) continue;
-    m.springs(out, 0) = keep[a];
-    m.springs(out, 1) = keep[b];
-    countStep(keep[a], keep[b]);
-    m.rest_length[out] = m.rest_length[s];
-    m.stiffness[out] = m.stiffness[s];
-    m.damping[out] = m.damping[s];
-    ++out;
+  {
+    std::int32_t* const sa = m.springs.col(0).data();
+    std::int32_t* const sb = m.springs.col(1).data();
+    double* const rest = m.rest_length.data();
+    double* const stiffness = m.stiffness.data();
+    double* const damping = m.damping.data();
+    for (Eigen::Index s = 0, rows = m.springs.rows(); s < rows; ++s) {
+      const std::int32_t fa = fate[sa[s]], fb = fate[sb[s]];
+      if ((fa | fb) < 0 || (fa & fb & 1)) continue;  // an end gone, or both touched (recomputed)
+      const int a = fa >> 1, b = fb >> 1;
+      sa[out] = a;
+      sb[out] = b;
+      countStep(a, b);
+      rest[out] = rest[s];
+      stiffness[out] = stiffness[s];
+      damping[out] = damping[s];
+      ++out;
+    }
   }
   Eigen::Index ns = out;
   for (const CutUpdate3DPrepared::Spring& s : springs) ns += (keep[s.a] >= 0 && keep[s.b] >= 0) ? 1 : 0;
