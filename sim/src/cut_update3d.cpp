@@ -138,6 +138,43 @@ bool lanczosAvx2() {
   return n;
 }
 
+// The Lanczos step's element-wise parts (per entry the operations Eigen's expressions
+// z -= a * q; z -= beta * prev; and q = z / b; do), each in one pass, compiled for baseline
+// x86-64 and for AVX2: the same IEEE operations either way (no FMA).
+[[gnu::always_inline]] inline void residualBody(Eigen::Index n, double* __restrict z, const double* __restrict q, double a,
+                                                const double* __restrict prev, double beta) {
+  if (prev == nullptr) {
+    for (Eigen::Index i = 0; i < n; ++i) z[i] = z[i] - a * q[i];
+  } else {
+    for (Eigen::Index i = 0; i < n; ++i) z[i] = (z[i] - a * q[i]) - beta * prev[i];
+  }
+}
+[[gnu::always_inline]] inline void nextBody(Eigen::Index n, const double* __restrict z, double b, double* __restrict q,
+                                            double* __restrict column) {
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const double v = z[i] / b;
+    q[i] = v;
+    column[i] = v;
+  }
+}
+void residualBaseline(Eigen::Index n, double* z, const double* q, double a, const double* prev, double beta) {
+  residualBody(n, z, q, a, prev, beta);
+}
+[[gnu::target("avx2")]] void residualAvx2(Eigen::Index n, double* z, const double* q, double a, const double* prev,
+                                          double beta) {
+  residualBody(n, z, q, a, prev, beta);
+}
+void nextBaseline(Eigen::Index n, const double* z, double b, double* q, double* column) { nextBody(n, z, b, q, column); }
+[[gnu::target("avx2")]] void nextAvx2(Eigen::Index n, const double* z, double b, double* q, double* column) {
+  nextBody(n, z, b, q, column);
+}
+void lanczosResidual(Eigen::Index n, double* z, const double* q, double a, const double* prev, double beta, bool avx2) {
+  (avx2 ? residualAvx2 : residualBaseline)(n, z, q, a, prev, beta);
+}
+void lanczosNext(Eigen::Index n, const double* z, double b, double* q, double* column, bool avx2) {
+  (avx2 ? nextAvx2 : nextBaseline)(n, z, b, q, column);
+}
+
 // Top eigenvalue of M^-1/2 K M^-1/2 (springs linearised along their rest directions) over
 // the free nodes `nodes`, every other node held fixed (a principal submatrix), by Lanczos.
 // `start` (#N x 3, may be null or zero) is mixed into the deterministic start vector; `mode`
@@ -337,12 +374,13 @@ double topEigenvalue(const Model& m, const cutting::Positions& X, const std::vec
     return eig_exact.eigenvalues()[size - 1] * scale;
   };
   for (int j = 0; j < max_steps; ++j) {
-    Q.col(j) = q;
+    if (j == 0) Q.col(j) = q;  // later columns are written with q (below)
     apply(q, z);
     const double a = q.dot(z);
     alpha.push_back(a);
-    z -= a * q;
-    if (j > 0) z -= beta.back() * Q.col(j - 1);
+    // z -= a q, then z -= beta Q_{j-1}: the same operations per entry, in one pass.
+    lanczosResidual(n3, z.data(), q.data(), a, j > 0 ? Q.col(j - 1).data() : nullptr, j > 0 ? beta.back() : 0.0,
+                    avx2);
     if (reorthogonalise) {
       q_dot_z.head(j + 1).noalias() = Q.leftCols(j + 1).transpose() * z;
       q_proj.noalias() = Q.leftCols(j + 1) * q_dot_z.head(j + 1);
@@ -423,7 +461,7 @@ double topEigenvalue(const Model& m, const cutting::Positions& X, const std::vec
       if ((residual <= options.lanczos_tolerance * std::abs(theta) && settled) || last) break;
     }
     beta.push_back(b);
-    q = z / b;
+    lanczosNext(n3, z.data(), b, q.data(), Q.col(j + 1).data(), avx2);  // q = z / b, and Q's next column
   }
   if (mode != nullptr) {
     const Eigen::VectorXd y = Q.leftCols(ritz.size()) * ritz;
