@@ -4,7 +4,9 @@
 #include <array>
 #include <cmath>
 #include <functional>
+#include <immintrin.h>
 #include <limits>
+#include <memory>
 #include <string>
 
 #include "hysim/sim/tissue_update3d.hpp"
@@ -63,6 +65,116 @@ double topTridiagonalEigenvalue(const Eigen::VectorXd& diag, const Eigen::Vector
 
 namespace {
 
+// The Lanczos operator's AVX2 form (see topEigenvalue): the same IEEE operations in the same
+// order as the scalar loop, 4 lanes per node (x, y, z, pad), so the results are the same to
+// the last bit (no FMA: the AVX2 build does not enable it, and ISO C++ mode keeps contraction
+// off). The pad lanes carry values that are never read back.
+struct alignas(32) FreeSpring4 {
+  double wa[4], wb[4];  // pad lane 0
+  std::int64_t a, b;    // 4 * local index
+};
+
+bool lanczosAvx2() {
+  static const bool has = __builtin_cpu_supports("avx2");
+  return has;
+}
+
+// z = H u + sum over springs: u and z #count x 3 (row-major), `cols` 12 per node (the three
+// columns of the symmetric held block, pad 0), u4 and z4 #count x 4 scratch.
+[[gnu::target("avx2")]] void applyAvx2(int count, const double* u, double* z, const double* cols,
+                                       const FreeSpring4* springs, std::size_t num_springs, double* u4, double* z4) {
+  const __m256i three = _mm256_set_epi64x(0, -1, -1, -1);
+  for (int k = 0; k < count; ++k) {
+    const double* uk = u + 3 * k;
+    _mm256_storeu_pd(u4 + 4 * k, _mm256_maskload_pd(uk, three));
+    const double* c = cols + 12 * k;
+    // (h0 x + h3 y) + h5 w, (h3 x + h1 y) + h4 w, (h5 x + h4 y) + h2 w
+    const __m256d xy = _mm256_add_pd(_mm256_mul_pd(_mm256_loadu_pd(c), _mm256_broadcast_sd(uk)),
+                                     _mm256_mul_pd(_mm256_loadu_pd(c + 4), _mm256_broadcast_sd(uk + 1)));
+    _mm256_storeu_pd(z4 + 4 * k, _mm256_add_pd(xy, _mm256_mul_pd(_mm256_loadu_pd(c + 8), _mm256_broadcast_sd(uk + 2))));
+  }
+  for (std::size_t i = 0; i < num_springs; ++i) {
+    const FreeSpring4& fs = springs[i];
+    const __m256d wa = _mm256_load_pd(fs.wa), wb = _mm256_load_pd(fs.wb);
+    double* za = z4 + fs.a;
+    double* zb = z4 + fs.b;
+    const __m256d pa = _mm256_mul_pd(wa, _mm256_loadu_pd(u4 + fs.a));
+    const __m256d pb = _mm256_mul_pd(wb, _mm256_loadu_pd(u4 + fs.b));
+    const __m256d lo = _mm256_unpacklo_pd(pb, pa);  // pb0 pa0 pb2 pa2
+    const __m256d hi = _mm256_unpackhi_pd(pb, pa);  // pb1 pa1 pb3 pa3
+    // ((pb0 + pb1) + pb2, (pa0 + pa1) + pa2), then their difference
+    const __m128d sums = _mm_add_pd(_mm_add_pd(_mm256_castpd256_pd128(lo), _mm256_castpd256_pd128(hi)),
+                                    _mm256_extractf128_pd(lo, 1));
+    const __m256d t = _mm256_broadcastsd_pd(_mm_sub_sd(sums, _mm_unpackhi_pd(sums, sums)));
+    _mm256_storeu_pd(za, _mm256_sub_pd(_mm256_loadu_pd(za), _mm256_mul_pd(t, wa)));
+    _mm256_storeu_pd(zb, _mm256_add_pd(_mm256_loadu_pd(zb), _mm256_mul_pd(t, wb)));
+  }
+  for (int k = 0; k < count; ++k) _mm256_maskstore_pd(z + 3 * k, three, _mm256_loadu_pd(z4 + 4 * k));
+}
+
+// The elements t of `after` that are not the old element old_of[t] with the same nodes in the
+// same order (o2n[before.T(old_of[t], k)] == after.T(t, k), k = 0..3), 4 at a time (and the
+// last T1 % 4 whatever they are), into `out` in increasing order; returns their number.
+[[gnu::target("avx2")]] int sameOrderCandidatesAvx2(int T1, const int* old_of, const std::int32_t* const after_col[4],
+                                                    const std::int32_t* const before_col[4], const std::int32_t* o2n,
+                                                    int* out) {
+  int n = 0, t = 0;
+  const __m128i minus1 = _mm_set1_epi32(-1);
+  for (; t + 4 <= T1; t += 4) {
+    const __m128i o = _mm_loadu_si128(reinterpret_cast<const __m128i*>(old_of + t));
+    const __m128i valid = _mm_cmpgt_epi32(o, minus1);
+    __m128i same = valid;
+    for (int c = 0; c < 4; ++c) {
+      const __m128i node = _mm_mask_i32gather_epi32(_mm_setzero_si128(), before_col[c], o, valid, 4);
+      const __m128i renumbered = _mm_mask_i32gather_epi32(minus1, o2n, node, valid, 4);
+      same = _mm_and_si128(same, _mm_cmpeq_epi32(renumbered, _mm_loadu_si128(reinterpret_cast<const __m128i*>(after_col[c] + t))));
+    }
+    const int bits = _mm_movemask_ps(_mm_castsi128_ps(same));
+    if (bits != 0xF)
+      for (int i = 0; i < 4; ++i)
+        if (!((bits >> i) & 1)) out[n++] = t + i;
+  }
+  for (; t < T1; ++t) out[n++] = t;
+  return n;
+}
+
+// The Lanczos step's element-wise parts (per entry the operations Eigen's expressions
+// z -= a * q; z -= beta * prev; and q = z / b; do), each in one pass, compiled for baseline
+// x86-64 and for AVX2: the same IEEE operations either way (no FMA).
+[[gnu::always_inline]] inline void residualBody(Eigen::Index n, double* __restrict z, const double* __restrict q, double a,
+                                                const double* __restrict prev, double beta) {
+  if (prev == nullptr) {
+    for (Eigen::Index i = 0; i < n; ++i) z[i] = z[i] - a * q[i];
+  } else {
+    for (Eigen::Index i = 0; i < n; ++i) z[i] = (z[i] - a * q[i]) - beta * prev[i];
+  }
+}
+[[gnu::always_inline]] inline void nextBody(Eigen::Index n, const double* __restrict z, double b, double* __restrict q,
+                                            double* __restrict column) {
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const double v = z[i] / b;
+    q[i] = v;
+    column[i] = v;
+  }
+}
+void residualBaseline(Eigen::Index n, double* z, const double* q, double a, const double* prev, double beta) {
+  residualBody(n, z, q, a, prev, beta);
+}
+[[gnu::target("avx2")]] void residualAvx2(Eigen::Index n, double* z, const double* q, double a, const double* prev,
+                                          double beta) {
+  residualBody(n, z, q, a, prev, beta);
+}
+void nextBaseline(Eigen::Index n, const double* z, double b, double* q, double* column) { nextBody(n, z, b, q, column); }
+[[gnu::target("avx2")]] void nextAvx2(Eigen::Index n, const double* z, double b, double* q, double* column) {
+  nextBody(n, z, b, q, column);
+}
+void lanczosResidual(Eigen::Index n, double* z, const double* q, double a, const double* prev, double beta, bool avx2) {
+  (avx2 ? residualAvx2 : residualBaseline)(n, z, q, a, prev, beta);
+}
+void lanczosNext(Eigen::Index n, const double* z, double b, double* q, double* column, bool avx2) {
+  (avx2 ? nextAvx2 : nextBaseline)(n, z, b, q, column);
+}
+
 // Top eigenvalue of M^-1/2 K M^-1/2 (springs linearised along their rest directions) over
 // the free nodes `nodes`, every other node held fixed (a principal submatrix), by Lanczos.
 // `start` (#N x 3, may be null or zero) is mixed into the deterministic start vector; `mode`
@@ -79,8 +191,23 @@ double topEigenvalue(const Model& m, const cutting::Positions& X, const std::vec
   if (steps_taken) *steps_taken = 0;
   if (count == 0) return 0.0;
   const StepSprings& st = m.step_springs;
-  std::vector<int> local(static_cast<size_t>(m.num_nodes), -1);
+  // Scratch kept between calls (per thread): `local` is all -1 between calls (reset below).
+  struct Scratch {
+    std::vector<int> local;
+    std::vector<FreeSpring4> springs4;
+    std::vector<double> held_block, cols, u4, z4;
+  };
+  thread_local Scratch scratch;
+  std::vector<int>& local = scratch.local;
+  if (local.size() < static_cast<size_t>(m.num_nodes)) local.resize(static_cast<size_t>(m.num_nodes), -1);
   for (int k = 0; k < count; ++k) local[nodes[k]] = k;
+  struct ResetLocal {
+    std::vector<int>& local;
+    const std::vector<int>& nodes;
+    ~ResetLocal() {
+      for (int node : nodes) local[node] = -1;
+    }
+  } reset_local{local, nodes};
   // The operator, with y = M^-1/2 u: a spring between free nodes contributes t = k d.(y_b - y_a)
   // to z_b along d and its negative to z_a; with w = sqrt(k) d / sqrt(m) at each end that is
   // t = w_b.u_b - w_a.u_a, z_a -= t w_a, z_b += t w_b. A spring to a held node (y = 0 there)
@@ -90,10 +217,15 @@ double topEigenvalue(const Model& m, const cutting::Positions& X, const std::vec
     double wa[3], wb[3];
   };
   std::vector<FreeSpring> springs;
-  springs.reserve(static_cast<size_t>(count) * 7);
-  std::vector<double> held_block(6 * static_cast<size_t>(count), 0.0);  // xx yy zz xy yz zx
+  std::vector<FreeSpring4>& springs4 = scratch.springs4;  // the AVX2 form
+  springs4.clear();
+  const bool avx2 = m.options.simd && lanczosAvx2();
+  if (!avx2) springs.reserve(static_cast<size_t>(count) * 7);
+  std::vector<double>& held_block = scratch.held_block;  // xx yy zz xy yz zx per node, zeroed at its turn
+  if (held_block.size() < 6 * static_cast<size_t>(count)) held_block.resize(6 * static_cast<size_t>(count));
   for (int k = 0; k < count; ++k) {
     const int node = nodes[k];
+    std::fill_n(&held_block[6 * static_cast<size_t>(k)], 6, 0.0);  // only node k's own turn adds to it
     for (int e = st.node_offset[node]; e < st.node_offset[node + 1]; ++e) {
       const int s = st.incident[e];
       const int a = st.a[s], b = st.b[s];
@@ -112,7 +244,19 @@ double topEigenvalue(const Model& m, const cutting::Positions& X, const std::vec
           fs.wa[c] = ca * d[c];
           fs.wb[c] = cb * d[c];
         }
-        springs.push_back(fs);
+        if (avx2) {
+          FreeSpring4 f4;
+          for (int c = 0; c < 3; ++c) {
+            f4.wa[c] = fs.wa[c];
+            f4.wb[c] = fs.wb[c];
+          }
+          f4.wa[3] = f4.wb[3] = 0.0;
+          f4.a = 4 * la;
+          f4.b = 4 * lb;
+          springs4.push_back(f4);
+        } else {
+          springs.push_back(fs);
+        }
       } else if (la == k || lb == k) {  // this node free, the other end held
         const Eigen::RowVector3d w = d * (sk / std::sqrt(m.mass[node]));
         double* h = &held_block[6 * static_cast<size_t>(k)];
@@ -126,7 +270,25 @@ double topEigenvalue(const Model& m, const cutting::Positions& X, const std::vec
     }
   }
   const Eigen::Index n3 = 3 * static_cast<Eigen::Index>(count);
+  std::vector<double>& cols = scratch.cols;
+  std::vector<double>& u4 = scratch.u4;
+  std::vector<double>& z4 = scratch.z4;
+  if (avx2) {
+    if (cols.size() < 12 * static_cast<size_t>(count)) cols.resize(12 * static_cast<size_t>(count));
+    if (u4.size() < 4 * static_cast<size_t>(count)) u4.resize(4 * static_cast<size_t>(count));
+    if (z4.size() < 4 * static_cast<size_t>(count)) z4.resize(4 * static_cast<size_t>(count));
+    for (int k = 0; k < count; ++k) {
+      const double* h = &held_block[6 * static_cast<size_t>(k)];
+      double* c = &cols[12 * static_cast<size_t>(k)];
+      const double col[12] = {h[0], h[3], h[5], 0.0, h[3], h[1], h[4], 0.0, h[5], h[4], h[2], 0.0};
+      std::copy(col, col + 12, c);
+    }
+  }
   auto apply = [&](const Eigen::VectorXd& u, Eigen::VectorXd& z) {
+    if (avx2) {
+      applyAvx2(count, u.data(), z.data(), cols.data(), springs4.data(), springs4.size(), u4.data(), z4.data());
+      return;
+    }
     const double* up = u.data();
     double* zp = z.data();
     const double* h = held_block.data();
@@ -212,12 +374,13 @@ double topEigenvalue(const Model& m, const cutting::Positions& X, const std::vec
     return eig_exact.eigenvalues()[size - 1] * scale;
   };
   for (int j = 0; j < max_steps; ++j) {
-    Q.col(j) = q;
+    if (j == 0) Q.col(j) = q;  // later columns are written with q (below)
     apply(q, z);
     const double a = q.dot(z);
     alpha.push_back(a);
-    z -= a * q;
-    if (j > 0) z -= beta.back() * Q.col(j - 1);
+    // z -= a q, then z -= beta Q_{j-1}: the same operations per entry, in one pass.
+    lanczosResidual(n3, z.data(), q.data(), a, j > 0 ? Q.col(j - 1).data() : nullptr, j > 0 ? beta.back() : 0.0,
+                    avx2);
     if (reorthogonalise) {
       q_dot_z.head(j + 1).noalias() = Q.leftCols(j + 1).transpose() * z;
       q_proj.noalias() = Q.leftCols(j + 1) * q_dot_z.head(j + 1);
@@ -298,7 +461,7 @@ double topEigenvalue(const Model& m, const cutting::Positions& X, const std::vec
       if ((residual <= options.lanczos_tolerance * std::abs(theta) && settled) || last) break;
     }
     beta.push_back(b);
-    q = z / b;
+    lanczosNext(n3, z.data(), b, q.data(), Q.col(j + 1).data(), avx2);  // q = z / b, and Q's next column
   }
   if (mode != nullptr) {
     const Eigen::VectorXd y = Q.leftCols(ritz.size()) * ritz;
@@ -380,7 +543,10 @@ Status prepareModelAfterCut3D(const Model& model, const cutting::TetMesh& before
                    " but the scene defines no material with that label"};
   }
   // Tets around each node (CSR).
-  std::vector<int> off(static_cast<size_t>(N1) + 1, 0), around(4 * static_cast<size_t>(T1));
+  // (`around` is written in full below: allocated without zero-filling it first.)
+  std::vector<int> off(static_cast<size_t>(N1) + 1, 0);
+  const std::unique_ptr<int[]> around_storage(new int[4 * static_cast<size_t>(T1)]);
+  int* const around = around_storage.get();
   for (int t = 0; t < T1; ++t)
     for (int k = 0; k < 4; ++k) ++off[after.T(t, k) + 1];
   for (int i = 0; i < N1; ++i) off[i + 1] += off[i];
@@ -432,11 +598,11 @@ Status prepareModelAfterCut3D(const Model& model, const cutting::TetMesh& before
                                        after.T.col(3).data()};
   const std::int32_t* before_col[4] = {before.T.col(0).data(), before.T.col(1).data(), before.T.col(2).data(),
                                         before.T.col(3).data()};
-  for (int t = 0; t < T1; ++t) {
+  auto compareElement = [&](int t) {
     const int o = old_of[t];
     if (o >= 0 && after_col[0][t] == o2n[before_col[0][o]] && after_col[1][t] == o2n[before_col[1][o]] &&
         after_col[2][t] == o2n[before_col[2][o]] && after_col[3][t] == o2n[before_col[3][o]])
-      continue;  // the same nodes in the same order: most elements
+      return;  // the same nodes in the same order: most elements
     bool same = o >= 0;
     if (same) {
       std::array<int, 4> a{}, b{};
@@ -454,6 +620,15 @@ Status prepareModelAfterCut3D(const Model& model, const cutting::TetMesh& before
       touchTet(t);
       if (o >= 0) touchOld(o);
     }
+  };
+  if (model.options.simd && lanczosAvx2() && T1 > 0) {
+    // The first test (same nodes in the same order) 4 elements at a time; the others as above.
+    const std::unique_ptr<int[]> candidates(new int[static_cast<size_t>(T1)]);
+    const int num_candidates =
+        sameOrderCandidatesAvx2(T1, old_of.data(), after_col, before_col, o2n.data(), candidates.get());
+    for (int i = 0; i < num_candidates; ++i) compareElement(candidates[i]);
+  } else {
+    for (int t = 0; t < T1; ++t) compareElement(t);
   }
   for (int t : change.added_elements)
     if (t >= 0 && t < T1) touchTet(t);
@@ -680,17 +855,43 @@ Status finishModelAfterCut3D(Model& model, const cutting::TetMesh& after, const 
   for (int i = 0; i < N2; ++i)
     if (!m.fixed[i]) m.inv_mass[i] = 1.0 / m.mass[i];
   // Unchanged springs, compacted in place (a row is read before any row at or above it is
-  // written), then the recomputed ones: the order of a full copy.
+  // written), then the recomputed ones: the order of a full copy. buildStepSprings's counting
+  // pass on the way.
+  std::vector<std::int32_t>& step_offset = m.step_springs.node_offset;
+  step_offset.assign(static_cast<size_t>(N2) + 1, 0);
+  int step_count = 0;
+  auto countStep = [&](int a, int b) {
+    if (m.fixed[a] && m.fixed[b]) return;
+    ++step_count;
+    ++step_offset[a + 1];
+    ++step_offset[b + 1];
+  };
+  // Each old node's fate in one lookup per spring end: 2 * its kept index + (touched ? 1 : 0),
+  // or -1 when it is gone (cut away or in a removed piece).
+  const std::unique_ptr<std::int32_t[]> fate(new std::int32_t[static_cast<size_t>(std::max(N0, 1))]);
+  for (int i = 0; i < N0; ++i) {
+    const int j = o2n[i];
+    fate[i] = j < 0 || keep[j] < 0 ? -1 : 2 * keep[j] + (touched[j] ? 1 : 0);
+  }
   Eigen::Index out = 0;
-  for (Eigen::Index s = 0; s < m.springs.rows(); ++s) {
-    const int a = o2n[m.springs(s, 0)], b = o2n[m.springs(s, 1)];
-    if (a < 0 || b < 0 || (touched[a] && touched[b]) || keep[a] < 0 || keep[b] < 0) continue;
-    m.springs(out, 0) = keep[a];
-    m.springs(out, 1) = keep[b];
-    m.rest_length[out] = m.rest_length[s];
-    m.stiffness[out] = m.stiffness[s];
-    m.damping[out] = m.damping[s];
-    ++out;
+  {
+    std::int32_t* const sa = m.springs.col(0).data();
+    std::int32_t* const sb = m.springs.col(1).data();
+    double* const rest = m.rest_length.data();
+    double* const stiffness = m.stiffness.data();
+    double* const damping = m.damping.data();
+    for (Eigen::Index s = 0, rows = m.springs.rows(); s < rows; ++s) {
+      const std::int32_t fa = fate[sa[s]], fb = fate[sb[s]];
+      if ((fa | fb) < 0 || (fa & fb & 1)) continue;  // an end gone, or both touched (recomputed)
+      const int a = fa >> 1, b = fb >> 1;
+      sa[out] = a;
+      sb[out] = b;
+      countStep(a, b);
+      rest[out] = rest[s];
+      stiffness[out] = stiffness[s];
+      damping[out] = damping[s];
+      ++out;
+    }
   }
   Eigen::Index ns = out;
   for (const CutUpdate3DPrepared::Spring& s : springs) ns += (keep[s.a] >= 0 && keep[s.b] >= 0) ? 1 : 0;
@@ -703,12 +904,13 @@ Status finishModelAfterCut3D(Model& model, const cutting::TetMesh& after, const 
     if (keep[sp.a] < 0 || keep[sp.b] < 0) continue;
     m.springs(out, 0) = keep[sp.a];
     m.springs(out, 1) = keep[sp.b];
+    countStep(keep[sp.a], keep[sp.b]);
     m.rest_length[out] = sp.rest;
     m.stiffness[out] = sp.k;
     m.damping[out] = sp.c;
     ++out;
   }
-  buildStepSprings(m);
+  fillStepSprings(m, step_count);
   cutting::Positions X(N2, 3);
   for (int i = 0; i < N1; ++i)
     if (keep[i] >= 0) X.row(keep[i]) = after.X.row(i);

@@ -73,31 +73,43 @@ void buildStepSprings(Model& m) {
     ++st.node_offset[a + 1];
     ++st.node_offset[b + 1];
   }
+  fillStepSprings(m, count);
+}
+
+void fillStepSprings(Model& m, int count) {
+  // One pass: each step spring's arrays and its two incidence entries (node_offset's prefix
+  // sums first; a node's entries in increasing spring order, as a pass over the filled arrays).
+  const int n = m.num_nodes;
+  const int ns = static_cast<int>(m.springs.rows());
+  StepSprings& st = m.step_springs;
   st.a.resize(count);
   st.b.resize(count);
   st.rest_length.resize(count);
   st.stiffness.resize(count);
   st.damping.resize(count);
+  for (int i = 0; i < n; ++i) st.node_offset[i + 1] += st.node_offset[i];
+  st.incident.resize(st.node_offset[n]);
+  st.sign.resize(st.node_offset[n]);
+  std::vector<int> fill(st.node_offset.begin(), st.node_offset.end() - 1);
+  const std::int32_t* const spring_a = m.springs.col(0).data();
+  const std::int32_t* const spring_b = m.springs.col(1).data();
+  const std::uint8_t* const fixed = m.fixed.data();
+  std::int32_t* const incident = st.incident.data();
+  double* const sign = st.sign.data();
+  int* const next = fill.data();
   for (int s = 0, k = 0; s < ns; ++s) {
-    const int a = m.springs(s, 0), b = m.springs(s, 1);
-    if (m.fixed[a] && m.fixed[b]) continue;
+    const int a = spring_a[s], b = spring_b[s];
+    if (fixed[a] && fixed[b]) continue;
     st.a[k] = a;
     st.b[k] = b;
     st.rest_length[k] = m.rest_length[s];
     st.stiffness[k] = m.stiffness[s];
     st.damping[k] = m.damping[s];
+    incident[next[a]] = k;
+    sign[next[a]++] = 1.0;
+    incident[next[b]] = k;
+    sign[next[b]++] = -1.0;
     ++k;
-  }
-  for (int i = 0; i < n; ++i) st.node_offset[i + 1] += st.node_offset[i];
-  st.incident.resize(st.node_offset[n]);
-  st.sign.resize(st.node_offset[n]);
-  std::vector<int> fill(st.node_offset.begin(), st.node_offset.end() - 1);
-  for (int k = 0; k < count; ++k) {
-    const int a = st.a[k], b = st.b[k];
-    st.incident[fill[a]] = k;
-    st.sign[fill[a]++] = 1.0;
-    st.incident[fill[b]] = k;
-    st.sign[fill[b]++] = -1.0;
   }
 }
 
@@ -250,13 +262,16 @@ State makeState(const Model& model, const TetMesh& mesh) {
   const int n = model.num_nodes;
   s.x = mesh.X;
   s.v = NodeVectors::Zero(n, 3);
+  // f stays zero at anchored nodes (the symplectic step writes free rows only); the
+  // integrators' scratch arrays and the spring forces are written before they are read in
+  // every step, so they are only sized (as the simulator's resetState does).
   s.f = NodeVectors::Zero(n, 3);
-  s.scratch0 = NodeVectors::Zero(n, 3);
-  s.scratch1 = NodeVectors::Zero(n, 3);
-  s.scratch2 = NodeVectors::Zero(n, 3);
-  s.spring_force = Eigen::MatrixX3d::Zero(model.step_springs.size(), 3);
-  s.solve0 = Eigen::MatrixX3d::Zero(n, 3);
-  s.solve1 = Eigen::MatrixX3d::Zero(n, 3);
+  s.scratch0.resize(n, 3);
+  s.scratch1.resize(n, 3);
+  s.scratch2.resize(n, 3);
+  s.spring_force.resize(model.step_springs.size(), 3);
+  s.solve0.resize(n, 3);
+  s.solve1.resize(n, 3);
   return s;
 }
 

@@ -335,6 +335,50 @@ TEST(TissueUpdate3D, DecidedEstimatesStopEarlyWithTheSameModel) {
   }
 }
 
+// The AVX2 forms (the Lanczos operator and step, the same-element test) and the baseline
+// ones must agree bit for bit, or a scene would hash differently by CPU.
+TEST(TissueUpdate3D, SimdAndBaselineUpdatesAreBitIdentical) {
+  const cutting::TetMesh mesh = testing::boxTetMesh(6, 6, 6, 1.0);
+  Material mat;
+  mat.label = 1;
+  mat.stiffness_damping_s = 1e-4;
+  std::vector<int> fixed;
+  for (int i = 0; i < mesh.numNodes(); ++i)
+    if (mesh.X(i, 2) < 0.5) fixed.push_back(i);
+  auto r = cutting::cut3d(mesh, *cutting::CutSurface::plane(Vec3(0, 0, 3.04), Vec3(0.03, 0.02, 1)));
+  ASSERT_TRUE(r.ok()) << r.error();
+  std::vector<std::uint8_t> flags(static_cast<size_t>(r->mesh.numNodes()), 0);
+  for (int i = 0; i < r->mesh.numNodes(); ++i) flags[i] = r->mesh.X(i, 2) < 0.5 ? 1 : 0;
+  for (const int max_substeps : {2, 0})
+    for (const bool global : {false, true}) {
+      ModelOptions simd, baseline;
+      simd.max_substeps = baseline.max_substeps = max_substeps;  // 2: every update scales masses
+      baseline.simd = false;
+      auto a0 = buildModel(mesh, {mat}, fixed, simd), b0 = buildModel(mesh, {mat}, fixed, baseline);
+      ASSERT_TRUE(a0.ok() && b0.ok());
+      CutUpdate3DOptions options;
+      if (global) options.mode_overlap = -1.0;
+      if (global) options.max_held_estimates = 0;
+      Model a = *a0, b = *b0;
+      CutUpdate3DReport ra, rb;
+      ASSERT_TRUE(updateModelAfterCut3D(a, mesh, r->mesh, r->change, flags, {}, options, &ra).ok());
+      ASSERT_TRUE(updateModelAfterCut3D(b, mesh, r->mesh, r->change, flags, {}, options, &rb).ok());
+      EXPECT_GT(ra.lanczos_steps, 0);
+      EXPECT_EQ(ra.lanczos_steps, rb.lanczos_steps);
+      EXPECT_EQ(ra.touched_nodes, rb.touched_nodes);
+      EXPECT_EQ(a.omega_max, b.omega_max) << "global " << global << " max_substeps " << max_substeps;
+      EXPECT_EQ(a.critical_dt, b.critical_dt);
+      EXPECT_EQ(a.substeps, b.substeps);
+      EXPECT_EQ(a.added_mass, b.added_mass);
+      EXPECT_TRUE(a.mass == b.mass);
+      EXPECT_TRUE(a.springs == b.springs);
+      EXPECT_TRUE(a.stiffness == b.stiffness);
+      EXPECT_TRUE(a.stability_mode == b.stability_mode);
+      EXPECT_TRUE(a.step_springs.incident == b.step_springs.incident);
+      EXPECT_TRUE(a.step_springs.stiffness == b.step_springs.stiffness);
+    }
+}
+
 // Global Lanczos estimate of `model` as it is (nothing changed, every node's mode "near"),
 // with the Lanczos options of `base`; *steps (optional) gets the Lanczos steps taken.
 double globalOmega(const Model& model, const cutting::TetMesh& mesh, const CutUpdate3DOptions& base = {},

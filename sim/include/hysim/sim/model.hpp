@@ -125,7 +125,8 @@ struct StepInput {
 Result<Model> buildModel(const cutting::TetMesh& mesh, const std::vector<Material>& materials,
                          const std::vector<int>& fixed_nodes, const ModelOptions& options);
 
-// Rest state: x = mesh positions, v = 0, scratch sized.
+// Rest state: x = mesh positions, v = 0, f = 0; scratch and spring forces sized (not zeroed:
+// the step writes them before it reads them).
 State makeState(const Model& model, const cutting::TetMesh& mesh);
 
 // Advances the state by one fixed step dt. Allocates nothing; never throws. Non-finite
