@@ -309,16 +309,8 @@ void Simulation::resetState(const sim::NodeVectors* x, const sim::NodeVectors* v
   } else {
     state_.v.setZero(n, 3);
   }
-  // f stays zero at anchored nodes (the symplectic step writes free rows only); the
-  // integrators' scratch arrays and the spring forces are written before they are read in
-  // every step, so they are only sized here (not zeroed: ~0.8 MB of stores per pass).
-  state_.f.setZero(n, 3);
-  state_.scratch0.resize(n, 3);
-  state_.scratch1.resize(n, 3);
-  state_.scratch2.resize(n, 3);
-  state_.spring_force.resize(model_.step_springs.size(), 3);
-  state_.solve0.resize(n, 3);
-  state_.solve1.resize(n, 3);
+  // The per-step arrays only sized, not zeroed (~0.8 MB of stores per pass saved).
+  sim::sizeStepArrays(model_, state_);
   state_.diverged = false;
   num_anchored_ = 0;
   for (std::uint8_t a : anchored_) num_anchored_ += a;

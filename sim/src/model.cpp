@@ -262,17 +262,19 @@ State makeState(const Model& model, const TetMesh& mesh) {
   const int n = model.num_nodes;
   s.x = mesh.X;
   s.v = NodeVectors::Zero(n, 3);
-  // f stays zero at anchored nodes (the symplectic step writes free rows only); the
-  // integrators' scratch arrays and the spring forces are written before they are read in
-  // every step, so they are only sized (as the simulator's resetState does).
-  s.f = NodeVectors::Zero(n, 3);
-  s.scratch0.resize(n, 3);
-  s.scratch1.resize(n, 3);
-  s.scratch2.resize(n, 3);
-  s.spring_force.resize(model.step_springs.size(), 3);
-  s.solve0.resize(n, 3);
-  s.solve1.resize(n, 3);
+  sizeStepArrays(model, s);
   return s;
+}
+
+void sizeStepArrays(const Model& model, State& state) {
+  const int n = model.num_nodes;
+  state.f.setZero(n, 3);
+  state.scratch0.resize(n, 3);
+  state.scratch1.resize(n, 3);
+  state.scratch2.resize(n, 3);
+  state.spring_force.resize(static_cast<Eigen::Index>(model.step_springs.size()), 3);
+  state.solve0.resize(n, 3);
+  state.solve1.resize(n, 3);
 }
 
 double kineticEnergy(const Model& model, const State& state) {

@@ -128,6 +128,10 @@ Result<Model> buildModel(const cutting::TetMesh& mesh, const std::vector<Materia
 // Rest state: x = mesh positions, v = 0, f = 0; scratch and spring forces sized (not zeroed:
 // the step writes them before it reads them).
 State makeState(const Model& model, const cutting::TetMesh& mesh);
+// Sizes the state's per-step arrays for the model: f zeroed (it stays zero at anchored nodes,
+// the symplectic step writes free rows only); the integrators' scratch arrays and the spring
+// forces only sized, as every step writes them before it reads them.
+void sizeStepArrays(const Model& model, State& state);
 
 // Advances the state by one fixed step dt. Allocates nothing; never throws. Non-finite
 // values or speeds above options.max_speed_mm_s count a warning and freeze the state.
