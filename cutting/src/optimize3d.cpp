@@ -52,6 +52,16 @@ namespace {
 using Vec3 = Eigen::Vector3d;
 constexpr int kFace[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
 
+// v[0, mid) and v[mid, end), each sorted, into one sorted list without repeats (what sort +
+// unique of the whole gives); scratch is working room.
+void mergeSortedRuns(std::vector<std::int32_t>& v, size_t mid, std::vector<std::int32_t>& scratch) {
+  scratch.clear();
+  const auto m = v.begin() + static_cast<std::ptrdiff_t>(mid);
+  std::merge(v.begin(), m, m, v.end(), std::back_inserter(scratch));
+  scratch.erase(std::unique(scratch.begin(), scratch.end()), scratch.end());
+  v.swap(scratch);
+}
+
 // Six times tetVolume (mesh.cpp), inlined, in scalars over the coordinate columns: Eigen's
 // cross (y1 z2 - z1 y2, z1 x2 - x1 z2, x1 y2 - y1 x2) and 3-vector dot ((a0 b0 + a1 b1) +
 // a2 b2), the same value as (x1 - x0).dot((x2 - x0).cross(x3 - x0)) (checked bit for bit).
@@ -182,11 +192,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       if (g != gained.end() && g->first == n) {
         const size_t mid = scratch.size();
         for (; g != gained.end() && g->first == n; ++g) scratch.push_back(g->second);
-        scratch2.clear();
-        std::merge(scratch.begin(), scratch.begin() + static_cast<std::ptrdiff_t>(mid),
-                   scratch.begin() + static_cast<std::ptrdiff_t>(mid), scratch.end(), std::back_inserter(scratch2));
-        scratch2.erase(std::unique(scratch2.begin(), scratch2.end()), scratch2.end());
-        scratch.swap(scratch2);
+        mergeSortedRuns(scratch, mid, scratch2);
       }
 #ifdef HYSIM_CHECK_EXACT
       if (std::adjacent_find(scratch.begin(), scratch.end(), std::greater_equal<std::int32_t>()) != scratch.end())
@@ -1760,13 +1766,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
         const size_t mid = tets.size();
         for (const std::int32_t *s = starB(group[gi]), *sEnd = starE(group[gi]); s < sEnd; ++s)
           if (!(*dead)[(*s)]) tets.push_back((*s));
-        if (gi > 0) {
-          tetsMerged.clear();
-          std::merge(tets.begin(), tets.begin() + static_cast<std::ptrdiff_t>(mid),
-                     tets.begin() + static_cast<std::ptrdiff_t>(mid), tets.end(), std::back_inserter(tetsMerged));
-          tetsMerged.erase(std::unique(tetsMerged.begin(), tetsMerged.end()), tetsMerged.end());
-          tets.swap(tetsMerged);
-        }
+        if (gi > 0) mergeSortedRuns(tets, mid, tetsMerged);
       }
 #ifdef HYSIM_CHECK_EXACT
       {
