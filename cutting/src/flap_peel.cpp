@@ -180,21 +180,12 @@ void peelFlaps(const TetMesh& mesh, const CutRegion& region, const std::vector<s
   // Candidates: poor live tets around the near nodes, each once.
   std::vector<std::int32_t> cands;
   std::vector<double> candQ;
-  // (The tets of the near nodes' lists, each once, in index order: a bit per tet, set while
-  // collecting and read back word by word in index order; the same list as sorting the
-  // concatenated lists and dropping repeats.)
+  // (The tets of the near nodes' lists, each once, in index order.)
   {
-    std::vector<std::uint64_t> bits(static_cast<size_t>(M) / 64 + 1, 0);
-    std::vector<std::int32_t> words;
+    IndexBits bits(M);
     for (int n : nearNodes)
-      for (const std::int32_t *s = stars.begin(n), *sEnd = stars.end(n); s < sEnd; ++s) {
-        std::uint64_t& word = bits[static_cast<size_t>(*s) >> 6];
-        if (word == 0) words.push_back(*s >> 6);
-        word |= std::uint64_t{1} << (*s & 63);
-      }
-    std::sort(words.begin(), words.end());
-    for (int wi : words)
-      for (std::uint64_t word = bits[wi]; word; word &= word - 1) cands.push_back(wi * 64 + std::countr_zero(word));
+      for (const std::int32_t *s = stars.begin(n), *sEnd = stars.end(n); s < sEnd; ++s) bits.mark(*s);
+    bits.drainInto(cands);
   }
   {
     size_t kept = 0;

@@ -216,44 +216,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   // volume_budget of the mesh's volume (tetVolume's value per tet, in scalars without the
   // out-of-line cross product: tetVolumeHere).
   double meshVolume = 0;
-  {
-    int t = 0;
-#if defined(__SSE2__)
-    // Two tets at a time in the lanes of SSE2 registers, tetVolume6Here's operations in its
-    // order, / 6.0 per lane; added in tet order as below (the same sum).
-    const double* cx = mesh.X.col(0).data();
-    const double* cy = mesh.X.col(1).data();
-    const double* cz = mesh.X.col(2).data();
-    const __m128d six = _mm_set1_pd(6.0);
-    for (; t + 1 < M; t += 2) {
-      const int p0 = mesh.T(t, 0), p1 = mesh.T(t, 1), p2 = mesh.T(t, 2), p3 = mesh.T(t, 3);
-      const int q0 = mesh.T(t + 1, 0), q1 = mesh.T(t + 1, 1), q2 = mesh.T(t + 1, 2), q3 = mesh.T(t + 1, 3);
-      auto two = [](const double* c, int i, int j) { return _mm_loadh_pd(_mm_load_sd(c + i), c + j); };
-      const __m128d x0 = two(cx, p0, q0), y0 = two(cy, p0, q0), z0 = two(cz, p0, q0);
-      const __m128d ax = _mm_sub_pd(two(cx, p1, q1), x0), ay = _mm_sub_pd(two(cy, p1, q1), y0),
-                    az = _mm_sub_pd(two(cz, p1, q1), z0);
-      const __m128d bx = _mm_sub_pd(two(cx, p2, q2), x0), by = _mm_sub_pd(two(cy, p2, q2), y0),
-                    bz = _mm_sub_pd(two(cz, p2, q2), z0);
-      const __m128d ex = _mm_sub_pd(two(cx, p3, q3), x0), ey = _mm_sub_pd(two(cy, p3, q3), y0),
-                    ez = _mm_sub_pd(two(cz, p3, q3), z0);
-      const __m128d nx = _mm_sub_pd(_mm_mul_pd(by, ez), _mm_mul_pd(bz, ey));
-      const __m128d ny = _mm_sub_pd(_mm_mul_pd(bz, ex), _mm_mul_pd(bx, ez));
-      const __m128d nz = _mm_sub_pd(_mm_mul_pd(bx, ey), _mm_mul_pd(by, ex));
-      const __m128d v6 = _mm_add_pd(_mm_add_pd(_mm_mul_pd(ax, nx), _mm_mul_pd(ay, ny)), _mm_mul_pd(az, nz));
-      const __m128d v = _mm_div_pd(v6, six);
-      const double v0 = _mm_cvtsd_f64(v), v1 = _mm_cvtsd_f64(_mm_unpackhi_pd(v, v));
-#ifdef HYSIM_CHECK_EXACT
-      {
-        const double r0 = tetVolumeHere(mesh, t), r1 = tetVolumeHere(mesh, t + 1);
-        if (std::memcmp(&r0, &v0, sizeof v0) != 0 || std::memcmp(&r1, &v1, sizeof v1) != 0) std::abort();
-      }
-#endif
-      meshVolume += v0;
-      meshVolume += v1;
-    }
-#endif
-    for (; t < M; ++t) meshVolume += tetVolumeHere(mesh, t);
-  }
+  for (int t = 0; t < M; ++t) meshVolume += tetVolumeHere(mesh, t);
   // Curved cuts: the budgets bound the net change of the mesh volume (collapses and moves
   // add and remove volume; what they move about cancels) and, at volume_churn_factor x
   // that, the sum of the absolute changes. Plane cuts: the sum of the absolute changes.
@@ -738,49 +701,23 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
         }
       frontier.swap(next);
     }
-    // The added seeds sorted, without repeats (as sort + unique): a bit per node, read back
-    // word by word in index order (as regionTets).
+    // The added seeds sorted, without repeats (as sort + unique).
     const size_t base = region.seeds.size();
     if (seeds.size() > base) {
-      std::vector<std::uint64_t> nodeBits(static_cast<size_t>(N) / 64 + 1, 0);
-      std::vector<std::int32_t> words;
-      for (size_t i = base; i < seeds.size(); ++i) {
-        const int v = seeds[i];
-        std::uint64_t& word = nodeBits[static_cast<size_t>(v) >> 6];
-        if (word == 0) words.push_back(v >> 6);
-        word |= std::uint64_t{1} << (v & 63);
-      }
-      std::sort(words.begin(), words.end());
+      IndexBits added(N);
+      for (size_t i = base; i < seeds.size(); ++i) added.mark(seeds[i]);
       seeds.resize(base);
-      for (int wi : words)
-        for (std::uint64_t word = nodeBits[wi]; word; word &= word - 1)
-          seeds.push_back(wi * 64 + std::countr_zero(word));
+      added.drainInto(seeds);
     }
   }
   // The live tets around the seeds, each once, in index order.
-  // A bit per tet: set while collecting, read back word by word (index order), cleared.
-  std::vector<std::uint64_t> tetBits(static_cast<size_t>(M) / 64 + 1, 0);
-  std::vector<std::int32_t> bitWords;
+  IndexBits tetBits(M);
   auto regionTets = [&](std::vector<std::int32_t>& out) {
     out.clear();
-    bitWords.clear();
     for (int n : seeds)
-      for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s) {
-        const int t = (*s);
-        if ((*dead)[t]) continue;
-        std::uint64_t& word = tetBits[static_cast<size_t>(t) >> 6];
-        if (word == 0) bitWords.push_back(t >> 6);
-        word |= std::uint64_t{1} << (t & 63);
-      }
-    std::sort(bitWords.begin(), bitWords.end());
-    for (int wi : bitWords) {
-      std::uint64_t word = tetBits[wi];
-      tetBits[wi] = 0;
-      while (word) {
-        out.push_back(wi * 64 + std::countr_zero(word));
-        word &= word - 1;
-      }
-    }
+      for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s)
+        if (!(*dead)[*s]) tetBits.mark(*s);
+    tetBits.drainInto(out);
   };
   std::vector<std::int32_t> peelStamp, failedAt;
   int peelCount = 0;
@@ -927,11 +864,10 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
         if (std::adjacent_find(cands.begin(), cands.end(), std::greater_equal<std::int32_t>()) != cands.end())
           std::abort();
 #endif
-        std::sort(flipChanged.begin(), flipChanged.end());
-        candsMerged.clear();
-        std::merge(cands.begin(), cands.end(), flipChanged.begin(), flipChanged.end(), std::back_inserter(candsMerged));
-        candsMerged.erase(std::unique(candsMerged.begin(), candsMerged.end()), candsMerged.end());
-        cands.swap(candsMerged);
+        const size_t mid = cands.size();
+        cands.insert(cands.end(), flipChanged.begin(), flipChanged.end());
+        std::sort(cands.begin() + static_cast<std::ptrdiff_t>(mid), cands.end());
+        mergeSortedRuns(cands, mid, candsMerged);
 #ifdef HYSIM_CHECK_EXACT
         if (ref != cands) std::abort();
 #endif

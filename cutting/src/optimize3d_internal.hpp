@@ -2,12 +2,39 @@
 // Shared between cut3d.cpp and optimize3d.cpp: what the local optimisation after a cut needs
 // to know about the cut (which nodes lie on it, the surface for side checks) and where to
 // start (the nodes the cut touched).
+#include <algorithm>
+#include <bit>
 #include <cstdint>
 #include <vector>
 
 #include "hysim/cutting/cut3d.hpp"
 
 namespace hysim::cutting {
+
+// A set of indices below n as a bit per index: mark() sets one (noting each word that gets
+// its first bit), drainInto() appends the set ones in increasing order (the sorted list without
+// repeats, as sort + unique of what was marked) and clears them, so the bits are all zero
+// between uses.
+struct IndexBits {
+  explicit IndexBits(int n) : bits(static_cast<size_t>(n) / 64 + 1, 0) {}
+  void mark(int i) {
+    std::uint64_t& word = bits[static_cast<size_t>(i) >> 6];
+    if (word == 0) words.push_back(i >> 6);
+    word |= std::uint64_t{1} << (i & 63);
+  }
+  void drainInto(std::vector<std::int32_t>& out) {
+    std::sort(words.begin(), words.end());
+    for (const int wi : words) {
+      for (std::uint64_t word = bits[wi]; word; word &= word - 1) out.push_back(wi * 64 + std::countr_zero(word));
+      bits[wi] = 0;
+    }
+    words.clear();
+  }
+
+ private:
+  std::vector<std::uint64_t> bits;
+  std::vector<std::int32_t> words;
+};
 
 // Node -> tet lists of a tet mesh (each list ascending): CSR rows (off, star), or, where
 // pool_start[n] >= 0, pool_len[n] entries of `pool` from there.

@@ -855,17 +855,7 @@ Status finishModelAfterCut3D(Model& model, const cutting::TetMesh& after, const 
   for (int i = 0; i < N2; ++i)
     if (!m.fixed[i]) m.inv_mass[i] = 1.0 / m.mass[i];
   // Unchanged springs, compacted in place (a row is read before any row at or above it is
-  // written), then the recomputed ones: the order of a full copy. buildStepSprings's counting
-  // pass on the way.
-  std::vector<std::int32_t>& step_offset = m.step_springs.node_offset;
-  step_offset.assign(static_cast<size_t>(N2) + 1, 0);
-  int step_count = 0;
-  auto countStep = [&](int a, int b) {
-    if (m.fixed[a] && m.fixed[b]) return;
-    ++step_count;
-    ++step_offset[a + 1];
-    ++step_offset[b + 1];
-  };
+  // written), then the recomputed ones: the order of a full copy.
   // Each old node's fate in one lookup per spring end: 2 * its kept index + (touched ? 1 : 0),
   // or -1 when it is gone (cut away or in a removed piece).
   const std::unique_ptr<std::int32_t[]> fate(new std::int32_t[static_cast<size_t>(std::max(N0, 1))]);
@@ -886,7 +876,6 @@ Status finishModelAfterCut3D(Model& model, const cutting::TetMesh& after, const 
       const int a = fa >> 1, b = fb >> 1;
       sa[out] = a;
       sb[out] = b;
-      countStep(a, b);
       rest[out] = rest[s];
       stiffness[out] = stiffness[s];
       damping[out] = damping[s];
@@ -904,13 +893,12 @@ Status finishModelAfterCut3D(Model& model, const cutting::TetMesh& after, const 
     if (keep[sp.a] < 0 || keep[sp.b] < 0) continue;
     m.springs(out, 0) = keep[sp.a];
     m.springs(out, 1) = keep[sp.b];
-    countStep(keep[sp.a], keep[sp.b]);
     m.rest_length[out] = sp.rest;
     m.stiffness[out] = sp.k;
     m.damping[out] = sp.c;
     ++out;
   }
-  fillStepSprings(m, step_count);
+  buildStepSprings(m);
   cutting::Positions X(N2, 3);
   for (int i = 0; i < N1; ++i)
     if (keep[i] >= 0) X.row(keep[i]) = after.X.row(i);

@@ -73,15 +73,8 @@ void buildStepSprings(Model& m) {
     ++st.node_offset[a + 1];
     ++st.node_offset[b + 1];
   }
-  fillStepSprings(m, count);
-}
-
-void fillStepSprings(Model& m, int count) {
   // One pass: each step spring's arrays and its two incidence entries (node_offset's prefix
   // sums first; a node's entries in increasing spring order, as a pass over the filled arrays).
-  const int n = m.num_nodes;
-  const int ns = static_cast<int>(m.springs.rows());
-  StepSprings& st = m.step_springs;
   st.a.resize(count);
   st.b.resize(count);
   st.rest_length.resize(count);

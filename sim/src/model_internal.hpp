@@ -11,9 +11,6 @@ namespace hysim::sim {
 
 // Model::step_springs from the spring arrays, fixed flags and num_nodes (O(#S + #N)).
 void buildStepSprings(Model& model);
-// buildStepSprings after its counting pass, done by the caller: `count` step springs (those
-// with a free end) and node_offset (#N + 1) holding node i's number of them at i + 1.
-void fillStepSprings(Model& model, int count);
 
 // The largest eigenvalue of the symmetric tridiagonal matrix with diagonal `diag` and
 // subdiagonal `sub` (size diag.size() - 1), to a few units in the last place of the matrix's

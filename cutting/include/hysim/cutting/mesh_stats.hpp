@@ -26,7 +26,7 @@ namespace detail {
 // radiusRatio of the tet (a, b, c, d); with `oriented`, -1 where the tet is not positively
 // oriented ((b - a).dot((c - a).cross(d - a)) not > 0), the optimiser's test.
 // The same value, bit for bit, as the plain Eigen formula (kept in tests/cutting/
-// test_mesh_stats.cpp, RadiusRatio.BitIdenticalToEigenFormula):
+// test_radius_ratio_exact.cpp, RadiusRatio.BitIdenticalToEigenFormula):
 //   volume = |(b - a).dot((c - a).cross(d - a))| / 6
 //   p = |b - a| |d - c|, q = |c - a| |d - b|, r = |d - a| |c - b|
 //   product = max(0, (p + q + r)(p + q - r)(p - q + r)(-p + q + r))
