@@ -723,81 +723,50 @@ Status prepareModelAfterCut3D(const Model& model, const cutting::TetMesh& before
   // The unchanged ones stay in the model's arrays (compacted in place by the second part,
   // once nothing can fail); `springs` collects the recomputed ones, which follow them.
   std::vector<CutUpdate3DPrepared::Spring>& springs = prepared->springs;
-  // Each (tet, edge) with both ends touched, sorted by (smaller node, larger node), an edge's
-  // tets in increasing order (the order buildModel sums them in): two stable counting sorts,
-  // by the larger node, then by the smaller.
-  struct EdgeOfTet {
-    int b, tet;
+  // Per touched node a in increasing order, the edges (a, b) to touched nodes b > a, in
+  // increasing b (buildModel's order), each summing its tets in increasing order (as
+  // buildModel does): a's tet list is in increasing order, so each b's sums are accumulated
+  // in that order, in a small table of a's neighbours (`slot`: b -> entry, -1 otherwise).
+  struct EdgeSum {
+    int b;
+    double ev, bev;
   };
-  constexpr int kTetEdges[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
-  std::vector<int> edge_tets_of;
-  auto touchesTwice = [&](int t) {
-    return touched[after.T(t, 0)] + touched[after.T(t, 1)] + touched[after.T(t, 2)] + touched[after.T(t, 3)] >= 2;
-  };
-  {
-    // Such tets lie around touched nodes: found from their tet lists when that is less work
-    // than a pass over all tets, then put in increasing order.
-    std::size_t touched_incidences = 0;
-    for (int r = 0; r < rep.touched_nodes; ++r)
-      touched_incidences += static_cast<std::size_t>(off[region_nodes[r] + 1] - off[region_nodes[r]]);
-    if (touched_incidences < static_cast<std::size_t>(T1) / 2) {
-      std::vector<std::uint8_t> seen(static_cast<size_t>(T1), 0);
-      for (int r = 0; r < rep.touched_nodes; ++r)
-        for (int e = off[region_nodes[r]]; e < off[region_nodes[r] + 1]; ++e) {
-          const int t = around[e];
-          if (seen[t]) continue;
-          seen[t] = 1;
-          if (touchesTwice(t)) edge_tets_of.push_back(t);
-        }
-      std::sort(edge_tets_of.begin(), edge_tets_of.end());
-    } else {
-      for (int t = 0; t < T1; ++t)
-        if (touchesTwice(t)) edge_tets_of.push_back(t);
-    }
-  }
-  std::vector<int> bucket(static_cast<size_t>(N1) + 1, 0), by_larger(static_cast<size_t>(N1) + 1, 0);
-  auto forTouchedEdges = [&](auto&& f) {
-    for (int t : edge_tets_of)
-      for (const auto& e : kTetEdges) {
-        const int a = after.T(t, e[0]), b = after.T(t, e[1]);
-        if (touched[a] && touched[b]) f(t, std::min(a, b), std::max(a, b));
-      }
-  };
-  forTouchedEdges([&](int, int a, int b) {
-    ++bucket[a + 1];
-    ++by_larger[b + 1];
-  });
-  for (int i = 0; i < N1; ++i) {
-    bucket[i + 1] += bucket[i];
-    by_larger[i + 1] += by_larger[i];
-  }
-  struct EdgeEnds {
-    int a, b, tet;
-  };
-  std::vector<EdgeEnds> by_b(static_cast<size_t>(bucket[N1]));
-  forTouchedEdges([&](int t, int a, int b) { by_b[by_larger[b]++] = {a, b, t}; });
-  std::vector<EdgeOfTet> edge_tets(static_cast<size_t>(bucket[N1]));
-  {
-    std::vector<int> fill(bucket.begin(), bucket.end() - 1);
-    for (const EdgeEnds& e : by_b) edge_tets[fill[e.a]++] = {e.b, e.tet};
-  }
+  std::vector<EdgeSum> edge_sums;
+  std::vector<int> slot(static_cast<size_t>(N1), -1);
   int recomputed = 0;
-  for (int a = 0; a < N1; ++a)
-    for (int i = bucket[a]; i < bucket[a + 1];) {
-      const int b = edge_tets[i].b;
-      double ev = 0.0, bev = 0.0;
-      for (; i < bucket[a + 1] && edge_tets[i].b == b; ++i) {
-        const int t = edge_tets[i].tet;
-        const double vol = tetVolume(t);
-        if (!(vol > 0.0)) return Error{"tet " + std::to_string(t) + " has non-positive volume " + std::to_string(vol)};
-        const Material& mat = model.materials[material[t]];
-        ev += mat.young_modulus_pa * vol;
-        bev += mat.stiffness_damping_s * mat.young_modulus_pa * vol;
+  for (int r = 0; r < rep.touched_nodes; ++r) {
+    const int a = region_nodes[r];
+    edge_sums.clear();
+    for (int e = off[a]; e < off[a + 1]; ++e) {
+      const int t = around[e];
+      const Material* mat = nullptr;
+      double vol = 0.0;
+      for (int k = 0; k < 4; ++k) {
+        const int b = after.T(t, k);
+        if (b <= a || !touched[b]) continue;
+        if (mat == nullptr) {
+          vol = tetVolume(t);
+          if (!(vol > 0.0)) return Error{"tet " + std::to_string(t) + " has non-positive volume " + std::to_string(vol)};
+          mat = &model.materials[material[t]];
+        }
+        int& at = slot[b];
+        if (at < 0) {
+          at = static_cast<int>(edge_sums.size());
+          edge_sums.push_back({b, 0.0, 0.0});
+        }
+        EdgeSum& sum = edge_sums[at];
+        sum.ev += mat->young_modulus_pa * vol;
+        sum.bev += mat->stiffness_damping_s * mat->young_modulus_pa * vol;
       }
-      const double len = (after.X.row(b) - after.X.row(a)).norm();
-      springs.push_back({a, b, len, ev / (len * len), bev / (len * len)});
+    }
+    for (const EdgeSum& sum : edge_sums) slot[sum.b] = -1;
+    std::sort(edge_sums.begin(), edge_sums.end(), [](const EdgeSum& x, const EdgeSum& y) { return x.b < y.b; });
+    for (const EdgeSum& sum : edge_sums) {
+      const double len = (after.X.row(sum.b) - after.X.row(a)).norm();
+      springs.push_back({a, sum.b, len, sum.ev / (len * len), sum.bev / (len * len)});
       ++recomputed;
     }
+  }
   rep.springs_recomputed = recomputed;
   prepared->num_nodes_before = N0;
   prepared->mass = std::move(mass);
