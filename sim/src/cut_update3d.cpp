@@ -543,25 +543,42 @@ Status prepareModelAfterCut3D(const Model& model, const cutting::TetMesh& before
                    " but the scene defines no material with that label"};
   }
   // Tets around each node (CSR).
-  // (`around` is written in full below: allocated without zero-filling it first.)
+  // (tv: the tets' nodes row by row, tv[4 t + k] = after.T(t, k), one cache line a tet for
+  // the look-ups by tet below; `around` is written in full below: allocated without
+  // zero-filling it first.)
   std::vector<int> off(static_cast<size_t>(N1) + 1, 0);
   const std::unique_ptr<int[]> around_storage(new int[4 * static_cast<size_t>(T1)]);
+  const std::unique_ptr<std::int32_t[]> tv_storage(new std::int32_t[4 * static_cast<size_t>(T1)]);
   int* const around = around_storage.get();
-  for (int t = 0; t < T1; ++t)
-    for (int k = 0; k < 4; ++k) ++off[after.T(t, k) + 1];
+  std::int32_t* const tv = tv_storage.get();
+  {
+    const std::int32_t* const c0 = after.T.col(0).data();
+    const std::int32_t* const c1 = after.T.col(1).data();
+    const std::int32_t* const c2 = after.T.col(2).data();
+    const std::int32_t* const c3 = after.T.col(3).data();
+    for (int t = 0; t < T1; ++t) {
+      std::int32_t* const row = tv + 4 * static_cast<size_t>(t);
+      row[0] = c0[t];
+      row[1] = c1[t];
+      row[2] = c2[t];
+      row[3] = c3[t];
+      for (int k = 0; k < 4; ++k) ++off[row[k] + 1];
+    }
+  }
+  auto node = [tv](int t, int k) { return tv[4 * static_cast<size_t>(t) + k]; };
   for (int i = 0; i < N1; ++i) off[i + 1] += off[i];
   {
     std::vector<int> fill(off.begin(), off.end() - 1);
     for (int t = 0; t < T1; ++t)
-      for (int k = 0; k < 4; ++k) around[fill[after.T(t, k)]++] = t;
+      for (int k = 0; k < 4; ++k) around[fill[node(t, k)]++] = t;
   }
   std::vector<double> volume(static_cast<size_t>(T1), std::nan(""));
   auto tetVolume = [&](int t) {
     if (std::isnan(volume[t])) {  // cutting::tetVolume's arithmetic, inlined
-      const Eigen::Vector3d x0 = after.X.row(after.T(t, 0));
-      const Eigen::Vector3d x1 = after.X.row(after.T(t, 1));
-      const Eigen::Vector3d x2 = after.X.row(after.T(t, 2));
-      const Eigen::Vector3d x3 = after.X.row(after.T(t, 3));
+      const Eigen::Vector3d x0 = after.X.row(node(t, 0));
+      const Eigen::Vector3d x1 = after.X.row(node(t, 1));
+      const Eigen::Vector3d x2 = after.X.row(node(t, 2));
+      const Eigen::Vector3d x3 = after.X.row(node(t, 3));
       volume[t] = (x1 - x0).dot((x2 - x0).cross(x3 - x0)) / 6.0;
     }
     return volume[t];
@@ -570,7 +587,7 @@ Status prepareModelAfterCut3D(const Model& model, const cutting::TetMesh& before
   // Touched nodes: their masses and the springs between them change.
   std::vector<std::uint8_t> touched(static_cast<size_t>(N1), 0);
   auto touchTet = [&](int t) {
-    for (int k = 0; k < 4; ++k) touched[after.T(t, k)] = 1;
+    for (int k = 0; k < 4; ++k) touched[node(t, k)] = 1;
   };
   for (const cutting::NewNode& nn : change.new_nodes)
     if (nn.id >= 0 && nn.id < N1) touched[nn.id] = 1;
@@ -607,7 +624,7 @@ Status prepareModelAfterCut3D(const Model& model, const cutting::TetMesh& before
     if (same) {
       std::array<int, 4> a{}, b{};
       for (int k = 0; k < 4; ++k) {
-        a[k] = after.T(t, k);
+        a[k] = node(t, k);
         b[k] = o2n[before.T(o, k)];
       }
       if (a != b) {  // the same nodes in another order are the same element
@@ -651,7 +668,7 @@ Status prepareModelAfterCut3D(const Model& model, const cutting::TetMesh& before
     for (int r = begin; r < end; ++r)
       for (int e = off[region_nodes[r]]; e < off[region_nodes[r] + 1]; ++e)
         for (int k = 0; k < 4; ++k) {
-          const int j = after.T(around[e], k);
+          const int j = node(around[e], k);
           if (!region[j]) {
             region[j] = 1;
             region_nodes.push_back(j);
@@ -679,7 +696,7 @@ Status prepareModelAfterCut3D(const Model& model, const cutting::TetMesh& before
       for (int e = off[j]; e < off[j + 1]; ++e) mass[j] += lumpedShare(around[e]);
   } else {
     for (int t = 0; t < T1; ++t) {
-      const int n0 = after.T(t, 0), n1 = after.T(t, 1), n2 = after.T(t, 2), n3 = after.T(t, 3);
+      const int n0 = node(t, 0), n1 = node(t, 1), n2 = node(t, 2), n3 = node(t, 3);
       if (!(region[n0] | region[n1] | region[n2] | region[n3])) continue;
       const double w = lumpedShare(t);
       if (region[n0]) mass[n0] += w;
@@ -742,7 +759,7 @@ Status prepareModelAfterCut3D(const Model& model, const cutting::TetMesh& before
       const Material* mat = nullptr;
       double vol = 0.0;
       for (int k = 0; k < 4; ++k) {
-        const int b = after.T(t, k);
+        const int b = node(t, k);
         if (b <= a || !touched[b]) continue;
         if (mat == nullptr) {
           vol = tetVolume(t);
