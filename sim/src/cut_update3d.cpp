@@ -195,7 +195,7 @@ double topEigenvalue(const Model& m, const cutting::Positions& X, const std::vec
   struct Scratch {
     std::vector<int> local;
     std::vector<FreeSpring4> springs4;
-    std::vector<double> held_block, cols, u4, z4;
+    std::vector<double> held_block, cols, u4, z4, root_mass;
   };
   thread_local Scratch scratch;
   std::vector<int>& local = scratch.local;
@@ -223,6 +223,10 @@ double topEigenvalue(const Model& m, const cutting::Positions& X, const std::vec
   if (!avx2) springs.reserve(static_cast<size_t>(count) * 7);
   std::vector<double>& held_block = scratch.held_block;  // xx yy zz xy yz zx per node, zeroed at its turn
   if (held_block.size() < 6 * static_cast<size_t>(count)) held_block.resize(6 * static_cast<size_t>(count));
+  // The square roots of the nodes' masses, once a node (the same values as taken per spring end).
+  std::vector<double>& root_mass = scratch.root_mass;
+  if (root_mass.size() < static_cast<size_t>(count)) root_mass.resize(static_cast<size_t>(count));
+  for (int k = 0; k < count; ++k) root_mass[k] = std::sqrt(m.mass[nodes[k]]);
   for (int k = 0; k < count; ++k) {
     const int node = nodes[k];
     std::fill_n(&held_block[6 * static_cast<size_t>(k)], 6, 0.0);  // only node k's own turn adds to it
@@ -239,7 +243,7 @@ double topEigenvalue(const Model& m, const cutting::Positions& X, const std::vec
         FreeSpring fs;
         fs.a = 3 * la;
         fs.b = 3 * lb;
-        const double ca = sk / std::sqrt(m.mass[a]), cb = sk / std::sqrt(m.mass[b]);
+        const double ca = sk / root_mass[la], cb = sk / root_mass[lb];
         for (int c = 0; c < 3; ++c) {
           fs.wa[c] = ca * d[c];
           fs.wb[c] = cb * d[c];
@@ -258,7 +262,7 @@ double topEigenvalue(const Model& m, const cutting::Positions& X, const std::vec
           springs.push_back(fs);
         }
       } else if (la == k || lb == k) {  // this node free, the other end held
-        const Eigen::RowVector3d w = d * (sk / std::sqrt(m.mass[node]));
+        const Eigen::RowVector3d w = d * (sk / root_mass[k]);
         double* h = &held_block[6 * static_cast<size_t>(k)];
         h[0] += w[0] * w[0];
         h[1] += w[1] * w[1];
