@@ -1271,24 +1271,37 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       {
         const double q = tetQ(t);
         if (lastResort && !(q < options.flap_quality)) return;
-        double mean = 0, lens[6];
+        // Edge lengths as Eigen's norm(): the square root of ((x x + y y) + z z).
+        double sq[6], lens[6];
         const Vec3 p[4] = {pos(mesh.T(t, 0)), pos(mesh.T(t, 1)), pos(mesh.T(t, 2)), pos(mesh.T(t, 3))};
         for (int a = 0, e = 0; a < 4; ++a)
-          for (int b = a + 1; b < 4; ++b, ++e) {
-            lens[e] = (p[a] - p[b]).norm();
-            mean += lens[e] / 6.0;
-          }
+          for (int b = a + 1; b < 4; ++b, ++e) sq[e] = (p[a] - p[b]).squaredNorm();
         // A tet at or above quality_target has only its short edges: none where the shortest
         // is not below collapse_fraction x the longest (a bound on the mean: the six rounded
         // sixths add up to at most hi (1 + 6 eps) < hi (1 + 1e-9)) or the local edge.
+        // (sqrt is correctly rounded, so monotone: the shortest and longest lengths are the
+        // roots of the smallest and largest squares; the other four are taken only past here.)
         if (q >= options.quality_target) {
-          double lo = lens[0], hi = lens[0];
+          double lo2 = sq[0], hi2 = sq[0];
           for (int e = 1; e < 6; ++e) {
-            lo = std::min(lo, lens[e]);
-            hi = std::max(hi, lens[e]);
+            lo2 = std::min(lo2, sq[e]);
+            hi2 = std::max(hi2, sq[e]);
           }
+          const double lo = std::sqrt(lo2), hi = std::sqrt(hi2);
           if (lo >= options.collapse_fraction * std::max(hi * (1 + 1e-9), region.edge_length)) return;
         }
+        double mean = 0;
+        for (int e = 0; e < 6; ++e) {
+          lens[e] = std::sqrt(sq[e]);
+          mean += lens[e] / 6.0;
+        }
+#ifdef HYSIM_CHECK_EXACT
+        for (int a = 0, e = 0; a < 4; ++a)
+          for (int b = a + 1; b < 4; ++b, ++e) {
+            const double ref = (p[a] - p[b]).norm();
+            if (std::memcmp(&ref, &lens[e], sizeof ref) != 0) std::abort();
+          }
+#endif
         for (int a = 0, e = 0; a < 4; ++a)
           for (int b = a + 1; b < 4; ++b, ++e) {
             const int x = mesh.T(t, a), y = mesh.T(t, b);
