@@ -219,7 +219,7 @@ inline std::uint64_t mix64(std::uint64_t x) {
 }
 int findLocal(const Tet& t, int v);
 template <class W>
-bool evenFacePairs(const W& w, int n, const std::vector<std::int32_t>& starOff, const std::vector<std::int32_t>& starTet) {
+bool evenFacePairs(const W& w, int n, const std::vector<std::int32_t>& starOff, const StarVector& starTet) {
   std::uint64_t acc = 0;
   for (int s = starOff[n]; s < starOff[n + 1]; ++s) {
     const auto& tv = w.tet(starTet[s]);
@@ -243,7 +243,7 @@ int findLocal(const Tet& t, int v) {
 void buildStarLists(const Tets& T, int numNodes, StarLists* lists) {
   const int M = static_cast<int>(T.rows());
   std::vector<std::int32_t>& off = lists->off;
-  std::vector<std::int32_t>& star = lists->star;
+  StarVector& star = lists->star;
   // Counts at off[n + 2], their prefix sums, then each tet at off[n + 1]++: afterwards
   // off[n] .. off[n + 1] is n's row (ascending: the tets in index order).
   off.assign(static_cast<size_t>(numNodes) + 2, 0);
@@ -505,7 +505,7 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
     buildStarLists(input.T, N0, &stars);
   }
   const std::vector<std::int32_t>& starOff = stars.off;
-  const std::vector<std::int32_t>& starTet = stars.star;
+  const StarVector& starTet = stars.star;
 
   auto crossingPoint = [&](const CrossedEdge& e) -> Vec3 {
     if (!plane) return e.point;

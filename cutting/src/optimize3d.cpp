@@ -135,7 +135,8 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   // everything else is local), live tets in index order. After edge collapses the lists of
   // the nodes whose tets died or changed are rebuilt (buildStars), into `ovrPool`; the others
   // keep their CSR rows.
-  std::vector<std::int32_t> off, star, ovrStart, ovrLen, ovrPool;
+  std::vector<std::int32_t> off, ovrStart, ovrLen, ovrPool;
+  StarVector star;
   bool built = false;
   if (region.stars != nullptr) {
     off.swap(region.stars->off);
