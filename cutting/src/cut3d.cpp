@@ -165,7 +165,9 @@ std::vector<EndCandidate> endCandidates(const std::vector<CrossedEdge>& crossed,
 // The output mesh is written once from them (Assemble).
 struct Work {
   std::vector<Vec3> X;             // #nodes: input rows (may move), then appended nodes
-  std::vector<Tet> T;              // #tets: input rows (modified in place), then appended tets
+  // #tets: input rows (modified in place), then appended tets (not zeroed as it grows: the
+  // constructor writes every input row, addTet the appended ones).
+  std::vector<Tet, NoInitAllocator<Tet>> T;
   std::vector<std::int32_t> extraMat;  // material of the appended tets
   int N0, M0;
 
