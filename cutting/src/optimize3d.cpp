@@ -575,7 +575,9 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   // goes away (compacted), which is fine.
   // linkOnly: only fill `link` (the boundary edges around v, up to the first face used by
   // more than two tets) and return whether the faces are; the loop check is skipped.
-  std::vector<std::int32_t> linkDeg, linkInc, tetLocal, faceKey;
+  // (Scratch that only grows, so that it is written without zeroing: tetLocal, faceKey,
+  // linkInc and discNbrs, v's neighbours in local number order.)
+  std::vector<std::int32_t> linkDeg, linkInc, tetLocal, faceKey, discNbrs;
   std::vector<std::uint16_t> faceUses;
   auto discAround = [&](int v, const std::vector<std::int32_t>& around, bool linkOnly = false) {
     link.clear();
@@ -584,10 +586,12 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     // count the pairs of each tet's other three nodes in a table over v's neighbours.
     // Each tet's three other nodes as local numbers (in the tet's order), read from the mesh
     // once.
-    nbrs.clear();
     const size_t n = around.size();
-    tetLocal.resize(3 * n + 1);  // (+1: a tet without v writes a fourth number)
-    bool threeEach = true;       // (every tet has v once: its three other nodes)
+    if (tetLocal.size() < 3 * n + 1) tetLocal.resize(3 * n + 1);  // (+1: a tet without v writes a fourth number)
+    if (discNbrs.size() < 4 * n) discNbrs.resize(4 * n);
+    std::int32_t* nb = discNbrs.data();
+    std::int32_t L = 0;     // neighbours numbered so far
+    bool threeEach = true;  // (every tet has v once: its three other nodes)
     for (size_t i = 0; i < n; ++i) {
       const int t = around[i];
       std::int32_t* o = &tetLocal[3 * i];
@@ -597,23 +601,22 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
         if (w == v) continue;
         std::int32_t& id = localId[w];
         if (id < 0) {
-          id = static_cast<std::int32_t>(nbrs.size());
-          nbrs.push_back(w);
+          id = L;
+          nb[L++] = w;
         }
         o[m++] = id;
       }
       threeEach = threeEach && m == 3;
     }
     if (!threeEach) {  // not a star of v (never so here)
-      for (int w : nbrs) localId[w] = -1;
+      for (std::int32_t i = 0; i < L; ++i) localId[nb[i]] = -1;
       return false;
     }
     // The faces at v of each tet, in the order of the face opposite each other node (faces
     // f != v's in order f = 0..3: without o[0], without o[1], without o[2]): the pairs
     // (o1, o2), (o0, o2), (o0, o1), each as its table index min * L + max.
-    const std::int32_t L = static_cast<std::int32_t>(nbrs.size());
     faceUses.assign(static_cast<size_t>(L) * L, 0);
-    faceKey.resize(3 * n);
+    if (faceKey.size() < 3 * n) faceKey.resize(3 * n);
     for (size_t i = 0; i < n; ++i) {
       const std::int32_t* o = &tetLocal[3 * i];
       std::int32_t* key = &faceKey[3 * i];
@@ -643,7 +646,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
         }
       }
     }
-    for (int w : nbrs) localId[w] = -1;
+    for (std::int32_t i = 0; i < L; ++i) localId[nb[i]] = -1;
     if (!manifold || link.empty() || linkOnly) return manifold;  // (link.empty(): an interior node)
     // One closed loop: every link vertex has degree 2, and walking from one edge visits all.
     // Each link vertex's (first two) edges in a table over v's neighbours: with all degrees 2
@@ -651,7 +654,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     // they form one loop.
     const size_t edges = link.size() / 2;
     linkDeg.assign(L, 0);
-    linkInc.resize(2 * static_cast<size_t>(L));
+    if (linkInc.size() < 2 * static_cast<size_t>(L)) linkInc.resize(2 * static_cast<size_t>(L));
     for (size_t i = 0; i < link.size(); ++i) {
       const std::int32_t id = link[i];
       if (linkDeg[id] < 2) linkInc[2 * id + linkDeg[id]] = static_cast<std::int32_t>(i / 2);
