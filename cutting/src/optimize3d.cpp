@@ -714,14 +714,38 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       added.drainInto(seeds);
     }
   }
-  // The live tets around the seeds, each once, in index order.
+  // The live tets around the seeds, each once, in index order (the live tets with a seed
+  // node). Kept (regionKept) with topoClock's value when found: while no tet has taken other
+  // nodes since (topoClock counts the writes of tets' nodes) and none came alive (only a
+  // written slot or an undone removal does, and no one asks between a removal and its undo),
+  // the list is the kept one without the tets that died since.
   IndexBits tetBits(M);
+  std::vector<std::int32_t> regionKept;
+  std::uint64_t topoClock = 0, regionClock = ~std::uint64_t{0};
   auto regionTets = [&](std::vector<std::int32_t>& out) {
     out.clear();
+    if (regionClock == topoClock) {
+      size_t kept = 0;
+      for (const std::int32_t t : regionKept)
+        if (!(*dead)[t]) regionKept[kept++] = t;
+      regionKept.resize(kept);
+      out.assign(regionKept.begin(), regionKept.end());
+#ifdef HYSIM_CHECK_EXACT
+      std::vector<std::int32_t> ref;
+      for (int n : seeds)
+        for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s)
+          if (!(*dead)[*s]) tetBits.mark(*s);
+      tetBits.drainInto(ref);
+      if (ref != out) std::abort();
+#endif
+      return;
+    }
     for (int n : seeds)
       for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s)
         if (!(*dead)[*s]) tetBits.mark(*s);
     tetBits.drainInto(out);
+    regionKept.assign(out.begin(), out.end());
+    regionClock = topoClock;
   };
   std::vector<std::int32_t> peelStamp, failedAt;
   int peelCount = 0;
@@ -836,6 +860,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       return radiusRatioOriented(pos(a), pos(b), pos(c), pos(d));  // -1 unless vol6(a, b, c, d) > 0
     };
     auto setTet = [&](int t, int a, int b, int c, int d) {
+      ++topoClock;
       flipChanged.push_back(t);
       const int v[4] = {a, b, c, d};
       for (int k = 0; k < 4; ++k) {
@@ -1559,6 +1584,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
           continue;
         }
         // Apply, check manifoldness around v and the other nodes of the removed tets, or undo.
+        ++topoClock;
         for (int t : dying) kill(t);
         touch(u);
         touch(v);
