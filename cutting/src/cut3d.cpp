@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
@@ -276,10 +277,26 @@ void patchStarLists(const Tets& before, const Tets& after, int numNodesAfter, st
                     StarLists* lists) {
   const int M0 = static_cast<int>(before.rows()), M1 = static_cast<int>(after.rows());
   const int N0 = static_cast<int>(lists->off.size()) - 1;
-  std::sort(changed.begin(), changed.end());
-  changed.erase(std::unique(changed.begin(), changed.end()), changed.end());
-  std::vector<std::uint8_t> isChanged(M0, 0);
-  for (const int t : changed) isChanged[t] = 1;
+  // The changed rows sorted, without repeats (what sort + unique gives), from a bit per row
+  // (the words that got a bit, sorted, then each word's bits in order); the merge below reads
+  // the bits.
+  std::vector<std::uint64_t> changedBits(static_cast<size_t>(M0) / 64 + 1, 0);
+  {
+    std::vector<std::int32_t> words;
+    for (const int t : changed) {
+      std::uint64_t& word = changedBits[static_cast<size_t>(t) >> 6];
+      if (word == 0) words.push_back(t >> 6);
+      word |= std::uint64_t{1} << (t & 63);
+    }
+    std::sort(words.begin(), words.end());
+    changed.clear();
+    for (const int wi : words)
+      for (std::uint64_t word = changedBits[wi]; word; word &= word - 1)
+        changed.push_back(wi * 64 + std::countr_zero(word));
+  }
+  auto isChanged = [&changedBits](std::int32_t t) {
+    return ((changedBits[static_cast<size_t>(t) >> 6] >> (t & 63)) & 1) != 0;
+  };
   // The nodes whose lists change (those of the changed tets before and after, and of the
   // appended tets), numbered as met; for each, the changed and appended tets that have it
   // now (CSR over those numbers, ascending: the tets are visited in index order).
@@ -323,7 +340,7 @@ void patchStarLists(const Tets& before, const Tets& after, int numNodesAfter, st
     const std::int32_t* gEnd = gained.data() + gainedOff[i + 1];
     const size_t start = pool.size();
     for (;;) {
-      while (o < oEnd && isChanged[*o]) ++o;
+      while (o < oEnd && isChanged(*o)) ++o;
       const bool haveOld = o < oEnd, haveNew = g < gEnd;
       if (!haveOld && !haveNew) break;
       if (haveOld && (!haveNew || *o < *g)) {
