@@ -1101,10 +1101,11 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
 
   std::vector<std::int32_t> cutNodes;
   if (!cutFaceList.empty()) {
+    // (Sorted without repeats, as sort + unique, through a bit per node.)
+    IndexBits nodeBits(w.numNodes());
     for (const auto& key : cutFaceList)
-      for (int v : key.first.v) cutNodes.push_back(v);
-    std::sort(cutNodes.begin(), cutNodes.end());
-    cutNodes.erase(std::unique(cutNodes.begin(), cutNodes.end()), cutNodes.end());
+      for (int v : key.first.v) nodeBits.mark(v);
+    nodeBits.drainInto(cutNodes);
     std::vector<std::int32_t> slot(w.numNodes(), -1);
     for (size_t i = 0; i < cutNodes.size(); ++i) slot[cutNodes[i]] = static_cast<std::int32_t>(i);
     // Stars of the cut nodes within the local tets (CSR, each ascending: filled from the
@@ -1269,7 +1270,12 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
   std::iota(change.node_old_to_new.begin(), change.node_old_to_new.end(), 0);
   change.element_old_to_new.resize(M0);
   std::iota(change.element_old_to_new.begin(), change.element_old_to_new.end(), 0);
-  std::sort(splitOriginals.begin(), splitOriginals.end());
+  {  // (Each split original once: sorted through a bit per tet, as std::sort.)
+    IndexBits tetBits(M0);
+    for (const int o : splitOriginals) tetBits.mark(o);
+    splitOriginals.clear();
+    tetBits.drainInto(splitOriginals);
+  }
   // Added: the pieces of the split tets, i.e. each split original (its first piece keeps its
   // index) and every appended tet (the subdivision appends nothing else), ascending: the
   // originals (< M0) in order, then M0 .. M1-1.
@@ -1323,14 +1329,21 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
     report.flap_peeled = counts.flap_peeled;
     report.collapsed_edges = counts.collapsed;
     report.late_snaps = counts.late_snaps;
+    // (cutNodes is sorted: the added nodes sorted and merged in, as a sort of the whole.)
+    const auto mid = static_cast<std::ptrdiff_t>(cutNodes.size());
     cutNodes.insert(cutNodes.end(), counts.onto_cut.begin(), counts.onto_cut.end());
-    std::sort(cutNodes.begin(), cutNodes.end());
+    std::sort(cutNodes.begin() + mid, cutNodes.end());
+    std::inplace_merge(cutNodes.begin(), cutNodes.begin() + mid, cutNodes.end());
     report.peeled_volume = counts.peeled_volume;
     report.optimized_nodes = static_cast<int>(moved.size() - before);
     report.optimize_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - optStart).count();
   }
-  std::sort(moved.begin(), moved.end());
-  moved.erase(std::unique(moved.begin(), moved.end()), moved.end());
+  {  // (Sorted without repeats, as sort + unique, through a bit per node.)
+    IndexBits nodeBits(out.numNodes());
+    for (const int n : moved) nodeBits.mark(n);
+    moved.clear();
+    nodeBits.drainInto(moved);
+  }
   // Only surviving old nodes count as moved (new ones are described by new_nodes).
   for (int n : moved)
     if (n < N0) change.moved_nodes.push_back(n);
