@@ -1300,11 +1300,20 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       {
         const double q = tetQ(t);
         if (lastResort && !(q < options.flap_quality)) return;
-        // Edge lengths as Eigen's norm(): the square root of ((x x + y y) + z z).
+        // Edge lengths as Eigen's norm() of p[a] - p[b]: the square root of ((x x + y y) + z z),
+        // in scalars over the coordinate columns.
         double sq[6], lens[6];
-        const Vec3 p[4] = {pos(mesh.T(t, 0)), pos(mesh.T(t, 1)), pos(mesh.T(t, 2)), pos(mesh.T(t, 3))};
-        for (int a = 0, e = 0; a < 4; ++a)
-          for (int b = a + 1; b < 4; ++b, ++e) sq[e] = (p[a] - p[b]).squaredNorm();
+        {
+          const double* cx = mesh.X.col(0).data();
+          const double* cy = mesh.X.col(1).data();
+          const double* cz = mesh.X.col(2).data();
+          const int i[4] = {mesh.T(t, 0), mesh.T(t, 1), mesh.T(t, 2), mesh.T(t, 3)};
+          for (int a = 0, e = 0; a < 4; ++a)
+            for (int b = a + 1; b < 4; ++b, ++e) {
+              const double dx = cx[i[a]] - cx[i[b]], dy = cy[i[a]] - cy[i[b]], dz = cz[i[a]] - cz[i[b]];
+              sq[e] = (dx * dx + dy * dy) + dz * dz;
+            }
+        }
         // A tet at or above quality_target has only its short edges: none where the shortest
         // is not below collapse_fraction x the longest (a bound on the mean: the six rounded
         // sixths add up to at most hi (1 + 6 eps) < hi (1 + 1e-9)) or the local edge.
@@ -1325,6 +1334,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
           mean += lens[e] / 6.0;
         }
 #ifdef HYSIM_CHECK_EXACT
+        const Vec3 p[4] = {pos(mesh.T(t, 0)), pos(mesh.T(t, 1)), pos(mesh.T(t, 2)), pos(mesh.T(t, 3))};
         for (int a = 0, e = 0; a < 4; ++a)
           for (int b = a + 1; b < 4; ++b, ++e) {
             const double ref = (p[a] - p[b]).norm();
