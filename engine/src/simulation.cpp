@@ -957,21 +957,28 @@ void Simulation::finishPass() {
   // the same order), so this does not wait for the worker's compacted mesh.
   {
     kept_quality.resize(keep_tets.size());
-    std::vector<int> old_of(static_cast<size_t>(after.numTets()), -1);
-    for (int t = 0; t < static_cast<int>(change.element_old_to_new.size()); ++t) {
-      const int u = change.element_old_to_new[t];
-      if (u >= 0 && u < after.numTets()) old_of[u] = t;
-    }
     std::vector<std::uint8_t> moved(static_cast<size_t>(n), 0);
     for (int j : change.moved_nodes)
       if (j >= 0 && j < n) moved[j] = 1;
+    // The old element with the same nodes in the same order: updateFaces found it (its
+    // old_of); otherwise the element map's, its nodes compared here.
+    const bool old_known = face_change.old_of.size() == static_cast<size_t>(after.numTets());
+    std::vector<int> mapped;
+    if (!old_known) {
+      mapped.assign(static_cast<size_t>(after.numTets()), -1);
+      for (int t = 0; t < static_cast<int>(change.element_old_to_new.size()); ++t) {
+        const int u = change.element_old_to_new[t];
+        if (u >= 0 && u < after.numTets()) mapped[u] = t;
+      }
+    }
+    const std::vector<int>& old_of = old_known ? face_change.old_of : mapped;
     rec.q_min = std::numeric_limits<double>::infinity();
     for (size_t k = 0; k < keep_tets.size(); ++k) {
       const int t = keep_tets[k], o = old_of[t];
       bool same = o >= 0 && o < static_cast<int>(tet_quality_.size());
       for (int c = 0; c < 4 && same; ++c) {
         const int node = after.T(t, c);
-        same = !moved[node] && change.node_old_to_new[mesh_.T(o, c)] == node;
+        same = !moved[node] && (old_known || change.node_old_to_new[mesh_.T(o, c)] == node);
       }
       kept_quality[k] = same ? tet_quality_[o] : tetQuality(after, t);
       rec.q_min = std::min(rec.q_min, kept_quality[k]);
