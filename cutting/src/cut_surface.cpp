@@ -76,6 +76,22 @@ void CutSurface::finish(const std::vector<Tri>& tri) {
     const Tri& t = tri[order_[i]];
     leafTri_.push_back({t, t.n.dot((t.b - t.a).cross(t.c - t.a))});
   }
+  finishChildBoxes();
+}
+
+void CutSurface::finishChildBoxes() {
+  childBoxes_.assign(nodes_.size(), ChildBoxes{});
+  for (size_t id = 0; id < nodes_.size(); ++id) {
+    const Node& node = nodes_[id];
+    if (node.left < 0) continue;
+    ChildBoxes& c = childBoxes_[id];
+    for (int k = 0; k < 3; ++k) {
+      c.lo[k][0] = nodes_[node.left].box.min()[k];
+      c.lo[k][1] = nodes_[node.right].box.min()[k];
+      c.hi[k][0] = nodes_[node.left].box.max()[k];
+      c.hi[k][1] = nodes_[node.right].box.max()[k];
+    }
+  }
 }
 
 Result<CutSurface> CutSurface::triangles(const Positions& X, const Tris& F) {
@@ -152,6 +168,7 @@ Result<CutSurface> CutSurface::strip(const Positions& X, int rows, int row_size)
     const Tri& t = (*tri)[k];
     s.leafTri_.push_back({t, t.n.dot((t.b - t.a).cross(t.c - t.a))});
   }
+  s.finishChildBoxes();
   return s;
 }
 
@@ -240,24 +257,6 @@ inline double boxDistance2(const Eigen::AlignedBox3d& box, const Eigen::Vector3d
 #endif
 }
 
-// The children of an inner node whose boxes lie within `limit` (squared distance) of x onto
-// the walk's stack with their box distances, the nearer last (so popped first).
-template <class Node>
-inline void pushChildren(const std::vector<Node>& nodes, const Node& node, const Eigen::Vector3d& x, double limit,
-                         int* stack, double* stackDist, int& top) {
-  const double dl = boxDistance2(nodes[node.left].box, x), dr = boxDistance2(nodes[node.right].box, x);
-  const bool leftFirst = dl <= dr;
-  const double dFar = leftFirst ? dr : dl, dNear = leftFirst ? dl : dr;
-  if (dFar <= limit) {
-    stack[top] = leftFirst ? node.right : node.left;
-    stackDist[top++] = dFar;
-  }
-  if (dNear <= limit) {
-    stack[top] = leftFirst ? node.left : node.right;
-    stackDist[top++] = dNear;
-  }
-}
-
 // AlignedBox::intersects for two non-empty boxes (min <= max on every axis).
 inline bool boxesMeet(const Eigen::AlignedBox3d& box, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
   return box.min()[0] <= hi[0] && lo[0] <= box.max()[0] && box.min()[1] <= hi[1] && lo[1] <= box.max()[1] &&
@@ -294,6 +293,50 @@ inline Eigen::Vector3d closestPointOnTriangleInline(const Eigen::Vector3d& p, co
 }
 }  // namespace
 
+// Both children's box distances at once: per lane the terms of boxDistance2 in its order,
+// ((x^2 + y^2) + z^2 with each term max(min - p, 0) + max(p - max, 0)), so the same values bit
+// for bit. The farther child onto the stack when within `limit`; the nearer one returned when
+// within it (-1 otherwise): the walk visits it next, as when it was pushed last and popped at
+// once (its check when popped, distance > limit, failed then: the limit had not changed).
+#if defined(__GNUC__)
+__attribute__((always_inline))
+#endif
+inline int CutSurface::stepChildren(int id, const Eigen::Vector3d& x, double limit, int* stack, double* stackDist,
+                                     int& top) const {
+  const Node& node = nodes_[id];
+  double dl, dr;
+#if defined(__SSE2__)
+  const ChildBoxes& c = childBoxes_[id];
+  const __m128d zero = _mm_setzero_pd();
+  __m128d aux[3];
+  for (int k = 0; k < 3; ++k) {
+    const __m128d p = _mm_set1_pd(x[k]);
+    const __m128d below = _mm_sub_pd(_mm_load_pd(c.lo[k]), p), above = _mm_sub_pd(p, _mm_load_pd(c.hi[k]));
+    aux[k] = _mm_add_pd(_mm_max_pd(below, zero), _mm_max_pd(above, zero));
+  }
+  const __m128d sum = _mm_add_pd(_mm_add_pd(_mm_mul_pd(aux[0], aux[0]), _mm_mul_pd(aux[1], aux[1])),
+                                 _mm_mul_pd(aux[2], aux[2]));
+  dl = _mm_cvtsd_f64(sum);
+  dr = _mm_cvtsd_f64(_mm_unpackhi_pd(sum, sum));
+#ifdef HYSIM_CHECK_EXACT
+  {
+    const double rl = boxDistance2(nodes_[node.left].box, x), rr = boxDistance2(nodes_[node.right].box, x);
+    if (std::memcmp(&rl, &dl, sizeof dl) != 0 || std::memcmp(&rr, &dr, sizeof dr) != 0) std::abort();
+  }
+#endif
+#else
+  dl = boxDistance2(nodes_[node.left].box, x);
+  dr = boxDistance2(nodes_[node.right].box, x);
+#endif
+  const bool leftFirst = dl <= dr;
+  const double dFar = leftFirst ? dr : dl, dNear = leftFirst ? dl : dr;
+  if (dFar <= limit) {
+    stack[top] = leftFirst ? node.right : node.left;
+    stackDist[top++] = dFar;
+  }
+  return dNear <= limit ? (leftFirst ? node.left : node.right) : -1;
+}
+
 Eigen::Vector3d closestPointOnTriangle(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                                        const Eigen::Vector3d& c) {
   return closestPointOnTriangleInline(p, a, b, c);
@@ -318,16 +361,23 @@ double CutSurface::signedDistanceNear(const Eigen::Vector3d& x, double r, Eigen:
   Eigen::Vector3d bestPoint = x;
   // The stack holds each node with its box distance (computed when its parent pushed it: the
   // same value as computing it again when popped).
+  // (The walk is that of pushing the root, then popping a node, skipping it when its distance
+  // is above best, else testing a leaf's triangles or pushing an inner node's children within
+  // best, the nearer last; the nearer child, popped at once, is visited without the stack.)
   int stack[128];
   double stackDist[128];
   int top = 0;
-  stack[top] = 0;
-  stackDist[top++] = boxDistance2(nodes_[0].box, x);
-  while (top > 0) {
-    --top;
-    const Node& node = nodes_[stack[top]];
-    if (stackDist[top] > best) continue;  // (equal: a tie with a lower index may be there)
+  int id = boxDistance2(nodes_[0].box, x) > best ? -1 : 0;
+  for (;;) {
+    if (id < 0) {
+      if (top == 0) break;
+      --top;
+      if (stackDist[top] > best) continue;  // (equal: a tie with a lower index may be there)
+      id = stack[top];
+    }
+    const Node& node = nodes_[id];
     if (node.left < 0) {
+      id = -1;
       for (int i = node.begin; i < node.end; ++i) {
         const Tri& t = leafTri_[i].t;
         const Eigen::Vector3d q = closestPointOnTriangleInline(x, t.a, t.b, t.c);
@@ -341,8 +391,10 @@ double CutSurface::signedDistanceNear(const Eigen::Vector3d& x, double r, Eigen:
         }
       }
     } else if (top + 2 <= 128) {
-      // The nearer child first (pushed last): a close triangle found early prunes the rest.
-      pushChildren(nodes_, node, x, best, stack, stackDist, top);
+      // The nearer child first: a close triangle found early prunes the rest.
+      id = stepChildren(id, x, best, stack, stackDist, top);
+    } else {
+      id = -1;
     }
   }
   if (bestTri < 0 && std::isfinite(r)) return signedDistanceNear(x, std::numeric_limits<double>::infinity(), closest);
@@ -441,20 +493,26 @@ bool CutSurface::within(const Eigen::Vector3d& x, double r) const {
   int stack[128];
   double stackDist[128];  // (as in signedDistanceNear)
   int top = 0;
-  stack[top] = 0;
-  stackDist[top++] = boxDistance2(nodes_[0].box, x);
-  while (top > 0) {
-    --top;
-    const Node& node = nodes_[stack[top]];
-    if (stackDist[top] > limit) continue;
+  int id = boxDistance2(nodes_[0].box, x) > limit ? -1 : 0;
+  for (;;) {
+    if (id < 0) {
+      if (top == 0) break;
+      --top;
+      if (stackDist[top] > limit) continue;
+      id = stack[top];
+    }
+    const Node& node = nodes_[id];
     if (node.left < 0) {
+      id = -1;
       for (int i = node.begin; i < node.end; ++i) {
         const Tri& t = leafTri_[i].t;
         if (std::sqrt((closestPointOnTriangleInline(x, t.a, t.b, t.c) - x).squaredNorm()) <= r) return true;
       }
     } else if (top + 2 <= 128) {
-      // The nearer child first (pushed last): a hit there ends the walk sooner.
-      pushChildren(nodes_, node, x, limit, stack, stackDist, top);
+      // The nearer child first: a hit there ends the walk sooner.
+      id = stepChildren(id, x, limit, stack, stackDist, top);
+    } else {
+      id = -1;
     }
   }
   return false;

@@ -83,6 +83,11 @@ class CutSurface {
     int left = -1, right = -1;   // children; leaf when left < 0
     int begin = 0, end = 0;      // leaf: range in order_
   };
+  // Per inner node, its children's boxes axis by axis as (left, right) pairs: one step of a
+  // nearest-point walk measures both children with paired (SSE2) arithmetic.
+  struct alignas(16) ChildBoxes {
+    double lo[3][2], hi[3][2];
+  };
   struct LeafTri {
     Tri t;
     double area;  // t.n . ((b - a) x (c - a)), for the inside test of intersectSegment
@@ -98,12 +103,17 @@ class CutSurface {
   // triangles.
   void finish(const std::vector<Tri>& tri);
   int build(int begin, int end, BuildScratch& scratch);
+  // childBoxes_ from nodes_ (after the tree is built).
+  void finishChildBoxes();
+  // One step of a nearest-point walk at inner node `id` (see there).
+  int stepChildren(int id, const Eigen::Vector3d& x, double limit, int* stack, double* stackDist, int& top) const;
 
   bool is_plane_ = true;
   Eigen::Vector3d point_ = Eigen::Vector3d::Zero(), normal_ = Eigen::Vector3d::UnitZ();
   std::vector<int> order_;        // tree order -> input triangle index
   std::vector<Node> nodes_;
   std::vector<LeafTri> leafTri_;  // the triangles in tree order: input triangle order_[i] at i
+  std::vector<ChildBoxes> childBoxes_;  // by node id (a leaf's entry unused)
   Eigen::AlignedBox3d bounds_;
 };
 
