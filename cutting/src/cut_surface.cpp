@@ -337,6 +337,30 @@ inline int CutSurface::stepChildren(int id, const Eigen::Vector3d& x, double lim
   return dNear <= limit ? (leftFirst ? node.left : node.right) : -1;
 }
 
+// Which of inner node id's children's boxes meet the box [lo, hi] (bit 0: the left, bit 1: the
+// right): boxesMeet's comparisons (min <= hi and lo <= max on every axis, false with a NaN),
+// for both children at once.
+#if defined(__GNUC__)
+__attribute__((always_inline))
+#endif
+inline int CutSurface::childrenMeet(int id, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) const {
+#if defined(__SSE2__)
+  const ChildBoxes& c = childBoxes_[id];
+  __m128d meets[3];
+  for (int k = 0; k < 3; ++k)
+    meets[k] = _mm_and_pd(_mm_cmple_pd(_mm_load_pd(c.lo[k]), _mm_set1_pd(hi[k])),
+                          _mm_cmple_pd(_mm_set1_pd(lo[k]), _mm_load_pd(c.hi[k])));
+  const int mask = _mm_movemask_pd(_mm_and_pd(_mm_and_pd(meets[0], meets[1]), meets[2]));
+#ifdef HYSIM_CHECK_EXACT
+  if (mask != (int(boxesMeet(nodes_[nodes_[id].left].box, lo, hi)) | int(boxesMeet(nodes_[nodes_[id].right].box, lo, hi)) << 1))
+    std::abort();
+#endif
+  return mask;
+#else
+  return int(boxesMeet(nodes_[nodes_[id].left].box, lo, hi)) | int(boxesMeet(nodes_[nodes_[id].right].box, lo, hi)) << 1;
+#endif
+}
+
 Eigen::Vector3d closestPointOnTriangle(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                                        const Eigen::Vector3d& c) {
   return closestPointOnTriangleInline(p, a, b, c);
@@ -426,12 +450,20 @@ bool CutSurface::intersectSegment(const Eigen::Vector3d& a, const Eigen::Vector3
   const Eigen::Vector3d segLo = a.cwiseMin(b), segHi = a.cwiseMax(b);
   bool found = false;
   double bestT = 2.0;
+  // (The walk of pushing the root when its box meets the segment's, then popping a node,
+  // testing a leaf's triangles or pushing an inner node's children whose boxes meet the
+  // segment's, the left first; the right child, popped at once, is visited without the stack.)
   int stack[128];
   int top = 0;
-  if (boxesMeet(nodes_[0].box, segLo, segHi)) stack[top++] = 0;
-  while (top > 0) {
-    const Node& node = nodes_[stack[--top]];
+  int id = boxesMeet(nodes_[0].box, segLo, segHi) ? 0 : -1;
+  for (;;) {
+    if (id < 0) {
+      if (top == 0) break;
+      id = stack[--top];
+    }
+    const Node& node = nodes_[id];
     if (node.left < 0) {
+      id = -1;
       for (int i = node.begin; i < node.end; ++i) {
         const Tri& tr = leafTri_[i].t;
         double t, da, db;
@@ -455,8 +487,15 @@ bool CutSurface::intersectSegment(const Eigen::Vector3d& a, const Eigen::Vector3
     } else if (top + 2 <= 128) {
       // Children whose boxes miss the segment's are not pushed (the same walk, in the same
       // order, as testing them when popped).
-      if (boxesMeet(nodes_[node.left].box, segLo, segHi)) stack[top++] = node.left;
-      if (boxesMeet(nodes_[node.right].box, segLo, segHi)) stack[top++] = node.right;
+      const int meet = childrenMeet(id, segLo, segHi);
+      if (meet == 3) {
+        stack[top++] = node.left;
+        id = node.right;
+      } else {
+        id = meet == 2 ? node.right : meet == 1 ? node.left : -1;
+      }
+    } else {
+      id = -1;
     }
   }
   return found;
@@ -472,18 +511,28 @@ bool CutSurface::mayTouch(const Eigen::AlignedBox3d& box, double eps) const {
   Eigen::Vector3d grownLo = box.min(), grownHi = box.max();
   grownLo.array() -= eps;
   grownHi.array() += eps;
-  // Down the tree: the box meets a leaf's box (a few triangles).
+  // Down the tree: the box meets a leaf's box (a few triangles). (Only nodes whose boxes meet
+  // it are visited, the right child before the left, as when both were pushed and tested when
+  // popped. The depth guard: a tree is at most about log2(triangles) + 2 deep, far below it.)
+  if (!boxesMeet(nodes_[0].box, grownLo, grownHi)) return false;
   int stack[128];
   int top = 0;
-  stack[top++] = 0;
-  while (top > 0) {
-    const Node& node = nodes_[stack[--top]];
-    if (!boxesMeet(node.box, grownLo, grownHi)) continue;
+  int id = 0;
+  for (;;) {
+    if (id < 0) {
+      if (top == 0) return false;
+      id = stack[--top];
+    }
+    const Node& node = nodes_[id];
     if (node.left < 0 || top + 2 > 128) return true;
-    stack[top++] = node.left;
-    stack[top++] = node.right;
+    const int meet = childrenMeet(id, grownLo, grownHi);
+    if (meet == 3) {
+      stack[top++] = node.left;
+      id = node.right;
+    } else {
+      id = meet == 2 ? node.right : meet == 1 ? node.left : -1;
+    }
   }
-  return false;
 }
 
 bool CutSurface::within(const Eigen::Vector3d& x, double r) const {

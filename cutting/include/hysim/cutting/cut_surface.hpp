@@ -107,6 +107,8 @@ class CutSurface {
   void finishChildBoxes();
   // One step of a nearest-point walk at inner node `id` (see there).
   int stepChildren(int id, const Eigen::Vector3d& x, double limit, int* stack, double* stackDist, int& top) const;
+  // Which of inner node `id`'s children's boxes meet the box [lo, hi] (bit 0 left, bit 1 right).
+  int childrenMeet(int id, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) const;
 
   bool is_plane_ = true;
   Eigen::Vector3d point_ = Eigen::Vector3d::Zero(), normal_ = Eigen::Vector3d::UnitZ();
