@@ -76,10 +76,10 @@ void CutSurface::finish(const std::vector<Tri>& tri) {
     const Tri& t = tri[order_[i]];
     leafTri_.push_back({t, t.n.dot((t.b - t.a).cross(t.c - t.a))});
   }
-  finishChildBoxes();
+  finishWalkData();
 }
 
-void CutSurface::finishChildBoxes() {
+void CutSurface::finishWalkData() {
   childBoxes_.assign(nodes_.size(), ChildBoxes{});
   for (size_t id = 0; id < nodes_.size(); ++id) {
     const Node& node = nodes_[id];
@@ -91,6 +91,11 @@ void CutSurface::finishChildBoxes() {
       c.hi[k][0] = nodes_[node.left].box.max()[k];
       c.hi[k][1] = nodes_[node.right].box.max()[k];
     }
+  }
+  leafEdges_.resize(leafTri_.size());
+  for (size_t i = 0; i < leafTri_.size(); ++i) {
+    const Tri& t = leafTri_[i].t;
+    leafEdges_[i] = {t.b - t.a, t.c - t.a, t.c - t.b};
   }
 }
 
@@ -168,7 +173,7 @@ Result<CutSurface> CutSurface::strip(const Positions& X, int rows, int row_size)
     const Tri& t = (*tri)[k];
     s.leafTri_.push_back({t, t.n.dot((t.b - t.a).cross(t.c - t.a))});
   }
-  s.finishChildBoxes();
+  s.finishWalkData();
   return s;
 }
 
@@ -361,6 +366,36 @@ inline int CutSurface::childrenMeet(int id, const Eigen::Vector3d& lo, const Eig
 #endif
 }
 
+namespace {
+// closestPointOnTriangleInline with b - a, c - a and c - b given (as it computes them): the
+// same arithmetic on the same values, so the same point bit for bit.
+#if defined(__GNUC__)
+__attribute__((always_inline))
+#endif
+inline Eigen::Vector3d closestPointWithEdges(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
+                                             const Eigen::Vector3d& b, const Eigen::Vector3d& c,
+                                             const Eigen::Vector3d& ab, const Eigen::Vector3d& ac,
+                                             const Eigen::Vector3d& bc) {
+  const Eigen::Vector3d ap = p - a;
+  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0 && d2 <= 0) return a;
+  const Eigen::Vector3d bp = p - b;
+  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0 && d4 <= d3) return b;
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return a + (d1 / (d1 - d3)) * ab;
+  const Eigen::Vector3d cp = p - c;
+  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0 && d5 <= d6) return c;
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return a + (d2 / (d2 - d6)) * ac;
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) return b + ((d4 - d3) / ((d4 - d3) + (d5 - d6))) * bc;
+  const double denom = 1.0 / (va + vb + vc);
+  return a + ab * (vb * denom) + ac * (vc * denom);
+}
+}  // namespace
+
 Eigen::Vector3d closestPointOnTriangle(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                                        const Eigen::Vector3d& c) {
   return closestPointOnTriangleInline(p, a, b, c);
@@ -404,7 +439,14 @@ double CutSurface::signedDistanceNear(const Eigen::Vector3d& x, double r, Eigen:
       id = -1;
       for (int i = node.begin; i < node.end; ++i) {
         const Tri& t = leafTri_[i].t;
-        const Eigen::Vector3d q = closestPointOnTriangleInline(x, t.a, t.b, t.c);
+        const LeafEdges& e = leafEdges_[i];
+        const Eigen::Vector3d q = closestPointWithEdges(x, t.a, t.b, t.c, e.ab, e.ac, e.bc);
+#ifdef HYSIM_CHECK_EXACT
+        {
+          const Eigen::Vector3d ref = closestPointOnTriangleInline(x, t.a, t.b, t.c);
+          if (std::memcmp(ref.data(), q.data(), sizeof(double) * 3) != 0) std::abort();
+        }
+#endif
         const double d2 = (q - x).squaredNorm();
         // (Ties: the lower triangle index, whatever the order of the walk.)
         if (d2 < best || (d2 == best && order_[i] < bestTri)) {
@@ -555,7 +597,8 @@ bool CutSurface::within(const Eigen::Vector3d& x, double r) const {
       id = -1;
       for (int i = node.begin; i < node.end; ++i) {
         const Tri& t = leafTri_[i].t;
-        if (std::sqrt((closestPointOnTriangleInline(x, t.a, t.b, t.c) - x).squaredNorm()) <= r) return true;
+        const LeafEdges& e = leafEdges_[i];
+        if (std::sqrt((closestPointWithEdges(x, t.a, t.b, t.c, e.ab, e.ac, e.bc) - x).squaredNorm()) <= r) return true;
       }
     } else if (top + 2 <= 128) {
       // The nearer child first: a hit there ends the walk sooner.

@@ -88,6 +88,10 @@ class CutSurface {
   struct alignas(16) ChildBoxes {
     double lo[3][2], hi[3][2];
   };
+  // Per leaf triangle, b - a, c - a and c - b as closestPointOnTriangle computes them.
+  struct LeafEdges {
+    Eigen::Vector3d ab, ac, bc;
+  };
   struct LeafTri {
     Tri t;
     double area;  // t.n . ((b - a) x (c - a)), for the inside test of intersectSegment
@@ -103,8 +107,8 @@ class CutSurface {
   // triangles.
   void finish(const std::vector<Tri>& tri);
   int build(int begin, int end, BuildScratch& scratch);
-  // childBoxes_ from nodes_ (after the tree is built).
-  void finishChildBoxes();
+  // childBoxes_ and leafEdges_ from nodes_ and leafTri_ (after the tree is built).
+  void finishWalkData();
   // One step of a nearest-point walk at inner node `id` (see there).
   int stepChildren(int id, const Eigen::Vector3d& x, double limit, int* stack, double* stackDist, int& top) const;
   // Which of inner node `id`'s children's boxes meet the box [lo, hi] (bit 0 left, bit 1 right).
@@ -116,6 +120,7 @@ class CutSurface {
   std::vector<Node> nodes_;
   std::vector<LeafTri> leafTri_;  // the triangles in tree order: input triangle order_[i] at i
   std::vector<ChildBoxes> childBoxes_;  // by node id (a leaf's entry unused)
+  std::vector<LeafEdges> leafEdges_;    // by place in leafTri_
   Eigen::AlignedBox3d bounds_;
 };
 
