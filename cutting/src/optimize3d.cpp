@@ -1684,7 +1684,10 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     std::vector<std::uint64_t> targetEdges;
     std::vector<std::uint32_t> groupVer;
     const double near = options.collapse_fraction * region.edge_length;
-    auto inGroup = [&](int v) { return std::find(group.begin(), group.end(), v) != group.end(); };
+    // groupAt[v]: 1 + v's place in the group while trySnap runs (0: not in it; the group's
+    // nodes are distinct), for inGroup and the group's targets without a search.
+    std::vector<std::int8_t> groupAt(N, 0);
+    auto inGroup = [&](int v) { return groupAt[v] != 0; };
     // A retry (the group grown by a partner, nothing else changed: a failed trySnap leaves
     // everything as it was) takes the volume and q* of each changing tet without the new
     // member from the attempt before (prevGroup: its group size, 0 after a new group).
@@ -1694,7 +1697,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     // Moves the group onto the cut and removes the tets that go flat, if that passes the
     // checks; otherwise leaves everything as it was and names a near node (not on the cut, not
     // in the group) of the tet that failed, if there is one.
-    auto trySnap = [&](int* partner) {
+    auto trySnapMarked = [&](int* partner) {
       // The live tets of the group's stars, sorted, each once: each star is sorted, so a
       // merge of the runs (one node: its star as it is) gives what sort + unique gave.
       tets.clear();
@@ -1758,8 +1761,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
           for (int k = 0; k < 4; ++k) {
             const int v = mesh.T(t, k);
             p[k] = pos(v);
-            for (size_t g = 0; g < group.size(); ++g)
-              if (group[g] == v) p[k] = groupTo[g];
+            if (groupAt[v] != 0) p[k] = groupTo[groupAt[v] - 1];
           }
           vol = (p[1] - p[0]).dot((p[2] - p[0]).cross(p[3] - p[0])) / 6.0;
           q = vol > 0 ? radiusRatio(p[0], p[1], p[2], p[3]) : -1.0;
@@ -1823,6 +1825,12 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       }
       budget.spend(after - before);
       return true;
+    };
+    auto trySnap = [&](int* partner) {
+      for (size_t g = 0; g < group.size(); ++g) groupAt[group[g]] = static_cast<std::int8_t>(g + 1);
+      const bool ok = trySnapMarked(partner);
+      for (int g : group) groupAt[g] = 0;
+      return ok;
     };
     for (const auto& [dist, u] : cands) {
       if (onCut[u]) continue;
