@@ -1638,12 +1638,15 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     if (e.kind != 0 && e.x != pos(n)) e.kind = 0;
     return e;
   };
-  // |signed distance| of node n to the cut, and its nearest point.
-  auto nodeDistance = [&](int n, Vec3* closest) {
+  // |signed distance| of node n to the cut, and its nearest point. `within`: a distance n is
+  // known to be within (within() said so, or n is on the cut and `within` the on-surface
+  // tolerance), for the bounded search, which gives signedDistance's value and point (and
+  // searches everything after all where nothing is that near).
+  auto nodeDistance = [&](int n, Vec3* closest, double within = std::numeric_limits<double>::infinity()) {
     DistEntry& e = distEntry(n);
     if (e.kind != 1) {
       e.x = pos(n);
-      e.d = std::abs(region.surface->signedDistance(e.x, &e.closest));
+      e.d = std::abs(region.surface->signedDistanceNear(e.x, within, &e.closest));
       e.kind = 1;
     }
     if (closest) *closest = e.closest;
@@ -1675,7 +1678,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
         tried[u] = 1;
         const double limit = options.collapse_fraction * region.edge_length;
         if (!nodeWithin(u, limit)) continue;  // far: no nearest-point search
-        const double d = nodeDistance(u, nullptr);
+        const double d = nodeDistance(u, nullptr, limit);
         if (d < limit) cands.emplace_back(d, u);
       }
     std::sort(cands.begin(), cands.end());
@@ -1784,7 +1787,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       if (newMin < oldMin && worstTet >= 0) {
         for (int k = 0; k < 4; ++k) {
           const int v = mesh.T(worstTet, k);
-          if (!onCut[v] && !inGroup(v) && nodeWithin(v, near) && nodeDistance(v, nullptr) < near)
+          if (!onCut[v] && !inGroup(v) && nodeWithin(v, near) && nodeDistance(v, nullptr, near) < near)
             *partner = v;
         }
       }
@@ -2015,7 +2018,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       // y := its nearest point of the cut, which lies within |y - x| + dist(x) of y: the
       // search looks no farther (the same point as a full search).
       auto onCutAgain = [&](Vec3& y) {
-        const double r = (y - x).norm() + nodeDistance(n, nullptr);
+        const double r = (y - x).norm() + nodeDistance(n, nullptr, onCut[n] ? region.eps : std::numeric_limits<double>::infinity());
         region.surface->signedDistanceNear(Vec3(y), r, &y);
       };
       int farFromCut = curved && !onCut[n] ? -1 : 0;  // -1: not asked yet
