@@ -1725,6 +1725,14 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       changing.clear();
       double oldMin = 1.0, newMin = 1.0, before = 0, after = 0;
       int worstTet = -1;
+      // The partner: a near node of the worst tet off the cut and not in the group (the last).
+      auto namePartner = [&](int* partner) {
+        for (int k = 0; k < 4; ++k) {
+          const int v = mesh.T(worstTet, k);
+          if (!onCut[v] && !inGroup(v) && nodeWithin(v, near) && nodeDistance(v, nullptr, near) < near)
+            *partner = v;
+        }
+      };
       matVol.clear();
       const bool reuse = prevGroup > 0 && prevGroup + 1 == group.size();
       const int added = reuse ? group.back() : -1;
@@ -1775,6 +1783,14 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
         if (q < newMin) {
           newMin = q;
           worstTet = t;
+          // An inverted tet (q* -1, below every q* >= 0): the try fails and this is the worst
+          // tet whatever follows (a later one must be strictly worse). Without a partner from
+          // it, the caller ends the chain (nothing below is used: stop here).
+          if (q < 0 && !last) {
+            int p = -1;
+            namePartner(&p);
+            if (p < 0) return false;
+          }
         }
         after += vol;
         if (last && newMin < oldMin) return false;
@@ -1784,13 +1800,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       prevVol.swap(curVol);
       prevQ.swap(curQ);
       const double change = std::abs(after - before);
-      if (newMin < oldMin && worstTet >= 0) {
-        for (int k = 0; k < 4; ++k) {
-          const int v = mesh.T(worstTet, k);
-          if (!onCut[v] && !inGroup(v) && nodeWithin(v, near) && nodeDistance(v, nullptr, near) < near)
-            *partner = v;
-        }
-      }
+      if (newMin < oldMin && worstTet >= 0) namePartner(partner);
       if (dying.empty() || changing.empty() || newMin < oldMin ||
           change > options.collapse_volume_fraction * std::max(before, refVolume) || !budget.fits(after - before) ||
           !matFits(before)) {
