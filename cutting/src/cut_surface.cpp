@@ -306,16 +306,19 @@ inline Eigen::Vector3d closestPointOnTriangleInline(const Eigen::Vector3d& p, co
 #if defined(__GNUC__)
 __attribute__((always_inline))
 #endif
-inline int CutSurface::stepChildren(int id, const Eigen::Vector3d& x, double limit, int* stack, double* stackDist,
+inline int CutSurface::stepChildren(int id, const double* xx, double limit, int* stack, double* stackDist,
                                      int& top) const {
   const Node& node = nodes_[id];
   double dl, dr;
+#if !defined(__SSE2__) || defined(HYSIM_CHECK_EXACT)
+  const Eigen::Vector3d x(xx[0], xx[2], xx[4]);
+#endif
 #if defined(__SSE2__)
   const ChildBoxes& c = childBoxes_[id];
   const __m128d zero = _mm_setzero_pd();
   __m128d aux[3];
   for (int k = 0; k < 3; ++k) {
-    const __m128d p = _mm_set1_pd(x[k]);
+    const __m128d p = _mm_load_pd(xx + 2 * k);
     const __m128d below = _mm_sub_pd(_mm_load_pd(c.lo[k]), p), above = _mm_sub_pd(p, _mm_load_pd(c.hi[k]));
     aux[k] = _mm_add_pd(_mm_max_pd(below, zero), _mm_max_pd(above, zero));
   }
@@ -348,13 +351,16 @@ inline int CutSurface::stepChildren(int id, const Eigen::Vector3d& x, double lim
 #if defined(__GNUC__)
 __attribute__((always_inline))
 #endif
-inline int CutSurface::childrenMeet(int id, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) const {
+inline int CutSurface::childrenMeet(int id, const double* lohi) const {
+#if !defined(__SSE2__) || defined(HYSIM_CHECK_EXACT)
+  const Eigen::Vector3d lo(lohi[0], lohi[2], lohi[4]), hi(lohi[6], lohi[8], lohi[10]);
+#endif
 #if defined(__SSE2__)
   const ChildBoxes& c = childBoxes_[id];
   __m128d meets[3];
   for (int k = 0; k < 3; ++k)
-    meets[k] = _mm_and_pd(_mm_cmple_pd(_mm_load_pd(c.lo[k]), _mm_set1_pd(hi[k])),
-                          _mm_cmple_pd(_mm_set1_pd(lo[k]), _mm_load_pd(c.hi[k])));
+    meets[k] = _mm_and_pd(_mm_cmple_pd(_mm_load_pd(c.lo[k]), _mm_load_pd(lohi + 6 + 2 * k)),
+                          _mm_cmple_pd(_mm_load_pd(lohi + 2 * k), _mm_load_pd(c.hi[k])));
   const int mask = _mm_movemask_pd(_mm_and_pd(_mm_and_pd(meets[0], meets[1]), meets[2]));
 #ifdef HYSIM_CHECK_EXACT
   if (mask != (int(boxesMeet(nodes_[nodes_[id].left].box, lo, hi)) | int(boxesMeet(nodes_[nodes_[id].right].box, lo, hi)) << 1))
@@ -426,6 +432,7 @@ double CutSurface::signedDistanceNear(const Eigen::Vector3d& x, double r, Eigen:
   int stack[128];
   double stackDist[128];
   int top = 0;
+  alignas(16) const double xx[6] = {x[0], x[0], x[1], x[1], x[2], x[2]};
   int id = boxDistance2(nodes_[0].box, x) > best ? -1 : 0;
   for (;;) {
     if (id < 0) {
@@ -458,7 +465,7 @@ double CutSurface::signedDistanceNear(const Eigen::Vector3d& x, double r, Eigen:
       }
     } else if (top + 2 <= 128) {
       // The nearer child first: a close triangle found early prunes the rest.
-      id = stepChildren(id, x, best, stack, stackDist, top);
+      id = stepChildren(id, xx, best, stack, stackDist, top);
     } else {
       id = -1;
     }
@@ -490,6 +497,8 @@ bool CutSurface::intersectSegment(const Eigen::Vector3d& a, const Eigen::Vector3
     return true;
   }
   const Eigen::Vector3d segLo = a.cwiseMin(b), segHi = a.cwiseMax(b);
+  alignas(16) const double segBox[12] = {segLo[0], segLo[0], segLo[1], segLo[1], segLo[2], segLo[2],
+                                         segHi[0], segHi[0], segHi[1], segHi[1], segHi[2], segHi[2]};
   bool found = false;
   double bestT = 2.0;
   // (The walk of pushing the root when its box meets the segment's, then popping a node,
@@ -529,7 +538,7 @@ bool CutSurface::intersectSegment(const Eigen::Vector3d& a, const Eigen::Vector3
     } else if (top + 2 <= 128) {
       // Children whose boxes miss the segment's are not pushed (the same walk, in the same
       // order, as testing them when popped).
-      const int meet = childrenMeet(id, segLo, segHi);
+      const int meet = childrenMeet(id, segBox);
       if (meet == 3) {
         stack[top++] = node.left;
         id = node.right;
@@ -557,6 +566,8 @@ bool CutSurface::mayTouch(const Eigen::AlignedBox3d& box, double eps) const {
   // it are visited, the right child before the left, as when both were pushed and tested when
   // popped. The depth guard: a tree is at most about log2(triangles) + 2 deep, far below it.)
   if (!boxesMeet(nodes_[0].box, grownLo, grownHi)) return false;
+  alignas(16) const double grownBox[12] = {grownLo[0], grownLo[0], grownLo[1], grownLo[1], grownLo[2], grownLo[2],
+                                           grownHi[0], grownHi[0], grownHi[1], grownHi[1], grownHi[2], grownHi[2]};
   int stack[128];
   int top = 0;
   int id = 0;
@@ -567,7 +578,7 @@ bool CutSurface::mayTouch(const Eigen::AlignedBox3d& box, double eps) const {
     }
     const Node& node = nodes_[id];
     if (node.left < 0 || top + 2 > 128) return true;
-    const int meet = childrenMeet(id, grownLo, grownHi);
+    const int meet = childrenMeet(id, grownBox);
     if (meet == 3) {
       stack[top++] = node.left;
       id = node.right;
@@ -584,6 +595,7 @@ bool CutSurface::within(const Eigen::Vector3d& x, double r) const {
   int stack[128];
   double stackDist[128];  // (as in signedDistanceNear)
   int top = 0;
+  alignas(16) const double xx[6] = {x[0], x[0], x[1], x[1], x[2], x[2]};
   int id = boxDistance2(nodes_[0].box, x) > limit ? -1 : 0;
   for (;;) {
     if (id < 0) {
@@ -602,7 +614,7 @@ bool CutSurface::within(const Eigen::Vector3d& x, double r) const {
       }
     } else if (top + 2 <= 128) {
       // The nearer child first: a hit there ends the walk sooner.
-      id = stepChildren(id, x, limit, stack, stackDist, top);
+      id = stepChildren(id, xx, limit, stack, stackDist, top);
     } else {
       id = -1;
     }

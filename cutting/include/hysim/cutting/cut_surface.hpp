@@ -109,10 +109,12 @@ class CutSurface {
   int build(int begin, int end, BuildScratch& scratch);
   // childBoxes_ and leafEdges_ from nodes_ and leafTri_ (after the tree is built).
   void finishWalkData();
-  // One step of a nearest-point walk at inner node `id` (see there).
-  int stepChildren(int id, const Eigen::Vector3d& x, double limit, int* stack, double* stackDist, int& top) const;
-  // Which of inner node `id`'s children's boxes meet the box [lo, hi] (bit 0 left, bit 1 right).
-  int childrenMeet(int id, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) const;
+  // One step of a nearest-point walk at inner node `id` (see there); xx: the point's
+  // coordinates, each twice (x0 x0 x1 x1 x2 x2, 16-byte aligned).
+  int stepChildren(int id, const double* xx, double limit, int* stack, double* stackDist, int& top) const;
+  // Which of inner node `id`'s children's boxes meet the box [lo, hi] (bit 0 left, bit 1 right);
+  // lohi: lo's coordinates, then hi's, each twice (16-byte aligned).
+  int childrenMeet(int id, const double* lohi) const;
 
   bool is_plane_ = true;
   Eigen::Vector3d point_ = Eigen::Vector3d::Zero(), normal_ = Eigen::Vector3d::UnitZ();
