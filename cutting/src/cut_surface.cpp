@@ -92,10 +92,10 @@ void CutSurface::finishWalkData() {
       c.hi[k][1] = nodes_[node.right].box.max()[k];
     }
   }
-  leafEdges_.resize(leafTri_.size());
+  nearTri_.resize(leafTri_.size());
   for (size_t i = 0; i < leafTri_.size(); ++i) {
     const Tri& t = leafTri_[i].t;
-    leafEdges_[i] = {t.b - t.a, t.c - t.a, t.c - t.b};
+    nearTri_[i] = {t.a, t.b, t.c, t.b - t.a, t.c - t.a, t.c - t.b};
   }
 }
 
@@ -445,9 +445,8 @@ double CutSurface::signedDistanceNear(const Eigen::Vector3d& x, double r, Eigen:
     if (node.left < 0) {
       id = -1;
       for (int i = node.begin; i < node.end; ++i) {
-        const Tri& t = leafTri_[i].t;
-        const LeafEdges& e = leafEdges_[i];
-        const Eigen::Vector3d q = closestPointWithEdges(x, t.a, t.b, t.c, e.ab, e.ac, e.bc);
+        const NearTri& t = nearTri_[i];
+        const Eigen::Vector3d q = closestPointWithEdges(x, t.a, t.b, t.c, t.ab, t.ac, t.bc);
 #ifdef HYSIM_CHECK_EXACT
         {
           const Eigen::Vector3d ref = closestPointOnTriangleInline(x, t.a, t.b, t.c);
@@ -608,9 +607,8 @@ bool CutSurface::within(const Eigen::Vector3d& x, double r) const {
     if (node.left < 0) {
       id = -1;
       for (int i = node.begin; i < node.end; ++i) {
-        const Tri& t = leafTri_[i].t;
-        const LeafEdges& e = leafEdges_[i];
-        if (std::sqrt((closestPointWithEdges(x, t.a, t.b, t.c, e.ab, e.ac, e.bc) - x).squaredNorm()) <= r) return true;
+        const NearTri& t = nearTri_[i];
+        if (std::sqrt((closestPointWithEdges(x, t.a, t.b, t.c, t.ab, t.ac, t.bc) - x).squaredNorm()) <= r) return true;
       }
     } else if (top + 2 <= 128) {
       // The nearer child first: a hit there ends the walk sooner.

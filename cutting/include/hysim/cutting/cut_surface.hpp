@@ -88,9 +88,10 @@ class CutSurface {
   struct alignas(16) ChildBoxes {
     double lo[3][2], hi[3][2];
   };
-  // Per leaf triangle, b - a, c - a and c - b as closestPointOnTriangle computes them.
-  struct LeafEdges {
-    Eigen::Vector3d ab, ac, bc;
+  // Per leaf triangle, what the nearest-point searches read: its vertices, and b - a, c - a,
+  // c - b as closestPointOnTriangle computes them.
+  struct NearTri {
+    Eigen::Vector3d a, b, c, ab, ac, bc;
   };
   struct LeafTri {
     Tri t;
@@ -107,7 +108,7 @@ class CutSurface {
   // triangles.
   void finish(const std::vector<Tri>& tri);
   int build(int begin, int end, BuildScratch& scratch);
-  // childBoxes_ and leafEdges_ from nodes_ and leafTri_ (after the tree is built).
+  // childBoxes_ and nearTri_ from nodes_ and leafTri_ (after the tree is built).
   void finishWalkData();
   // One step of a nearest-point walk at inner node `id` (see there); xx: the point's
   // coordinates, each twice (x0 x0 x1 x1 x2 x2, 16-byte aligned).
@@ -122,7 +123,7 @@ class CutSurface {
   std::vector<Node> nodes_;
   std::vector<LeafTri> leafTri_;  // the triangles in tree order: input triangle order_[i] at i
   std::vector<ChildBoxes> childBoxes_;  // by node id (a leaf's entry unused)
-  std::vector<LeafEdges> leafEdges_;    // by place in leafTri_
+  std::vector<NearTri> nearTri_;        // by place in leafTri_
   Eigen::AlignedBox3d bounds_;
 };
 
