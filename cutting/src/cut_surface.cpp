@@ -522,10 +522,10 @@ bool CutSurface::intersectSegment(const Eigen::Vector3d& a, const Eigen::Vector3
         // Inclusive inside test by signed sub-triangle areas along the normal.
         const double area = leafTri_[i].area;
         const double slack = -1e-12 * area;
-        const double w0 = tr.n.dot((tr.b - p).cross(tr.c - p));
-        const double w1 = tr.n.dot((tr.c - p).cross(tr.a - p));
-        const double w2 = tr.n.dot((tr.a - p).cross(tr.b - p));
-        if (w0 < slack || w1 < slack || w2 < slack) continue;
+        // (Each area tested as soon as it is known: the same values, fewer computed.)
+        if (tr.n.dot((tr.b - p).cross(tr.c - p)) < slack) continue;
+        if (tr.n.dot((tr.c - p).cross(tr.a - p)) < slack) continue;
+        if (tr.n.dot((tr.a - p).cross(tr.b - p)) < slack) continue;
         found = true;
         bestT = t;
         hit->t = t;
