@@ -97,6 +97,14 @@ void CutSurface::finishWalkData() {
     const Tri& t = leafTri_[i].t;
     nearTri_[i] = {t.a, t.b, t.c, t.b - t.a, t.c - t.a, t.c - t.b};
   }
+  planePairs_.resize(leafTri_.size());
+  for (size_t i = 0; i < leafTri_.size(); ++i) {
+    const Tri& t = leafTri_[i].t;
+    for (int k = 0; k < 3; ++k) {
+      planePairs_[i].p0[k][0] = planePairs_[i].p0[k][1] = t.a[k];
+      planePairs_[i].n[k][0] = planePairs_[i].n[k][1] = t.n[k];
+    }
+  }
 }
 
 Result<CutSurface> CutSurface::triangles(const Positions& X, const Tris& F) {
@@ -496,6 +504,7 @@ bool CutSurface::intersectSegment(const Eigen::Vector3d& a, const Eigen::Vector3
     return true;
   }
   const Eigen::Vector3d segLo = a.cwiseMin(b), segHi = a.cwiseMax(b);
+  alignas(16) const double ends[6] = {a[0], b[0], a[1], b[1], a[2], b[2]};  // a and b, axis by axis
   alignas(16) const double segBox[12] = {segLo[0], segLo[0], segLo[1], segLo[1], segLo[2], segLo[2],
                                          segHi[0], segHi[0], segHi[1], segHi[1], segHi[2], segHi[2]};
   bool found = false;
@@ -517,7 +526,28 @@ bool CutSurface::intersectSegment(const Eigen::Vector3d& a, const Eigen::Vector3
       for (int i = node.begin; i < node.end; ++i) {
         const Tri& tr = leafTri_[i].t;
         double t, da, db;
+#if defined(__SSE2__)
+        {
+          // tryPlane with both ends at once: lane 0 a, lane 1 b, each n.dot(end - p0) as Eigen's
+          // 3-vector dot sums it, (n0 d0 + n1 d1) + n2 d2, so the same values bit for bit.
+          const PlanePairs& pp = planePairs_[i];
+          __m128d d[3];
+          for (int k = 0; k < 3; ++k)
+            d[k] = _mm_mul_pd(_mm_load_pd(pp.n[k]), _mm_sub_pd(_mm_load_pd(ends + 2 * k), _mm_load_pd(pp.p0[k])));
+          const __m128d dd = _mm_add_pd(_mm_add_pd(d[0], d[1]), d[2]);
+          da = _mm_cvtsd_f64(dd);
+          db = _mm_cvtsd_f64(_mm_unpackhi_pd(dd, dd));
+#ifdef HYSIM_CHECK_EXACT
+          const double ra = tr.n.dot(a - tr.a), rb = tr.n.dot(b - tr.a);
+          if (std::memcmp(&ra, &da, sizeof da) != 0 || std::memcmp(&rb, &db, sizeof db) != 0) std::abort();
+#endif
+          if (!((da > eps && db < -eps) || (da < -eps && db > eps))) continue;
+          t = da / (da - db);
+          if (t >= bestT) continue;
+        }
+#else
         if (!tryPlane(tr.n, tr.a, &t, &da, &db) || t >= bestT) continue;
+#endif
         const Eigen::Vector3d p = a + t * (b - a);
         // Inclusive inside test by signed sub-triangle areas along the normal.
         const double area = leafTri_[i].area;

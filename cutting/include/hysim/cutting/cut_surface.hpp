@@ -93,6 +93,11 @@ class CutSurface {
   struct NearTri {
     Eigen::Vector3d a, b, c, ab, ac, bc;
   };
+  // Per leaf triangle, its first vertex and its normal axis by axis, each value twice: the
+  // segment test measures both ends of a segment from the triangle's plane at once.
+  struct alignas(16) PlanePairs {
+    double p0[3][2], n[3][2];
+  };
   struct LeafTri {
     Tri t;
     double area;  // t.n . ((b - a) x (c - a)), for the inside test of intersectSegment
@@ -108,7 +113,7 @@ class CutSurface {
   // triangles.
   void finish(const std::vector<Tri>& tri);
   int build(int begin, int end, BuildScratch& scratch);
-  // childBoxes_ and nearTri_ from nodes_ and leafTri_ (after the tree is built).
+  // childBoxes_, nearTri_ and planePairs_ from nodes_ and leafTri_ (after the tree is built).
   void finishWalkData();
   // One step of a nearest-point walk at inner node `id` (see there); xx: the point's
   // coordinates, each twice (x0 x0 x1 x1 x2 x2, 16-byte aligned).
@@ -124,6 +129,7 @@ class CutSurface {
   std::vector<LeafTri> leafTri_;  // the triangles in tree order: input triangle order_[i] at i
   std::vector<ChildBoxes> childBoxes_;  // by node id (a leaf's entry unused)
   std::vector<NearTri> nearTri_;        // by place in leafTri_
+  std::vector<PlanePairs> planePairs_;  // by place in leafTri_
   Eigen::AlignedBox3d bounds_;
 };
 
