@@ -97,6 +97,18 @@ void CutSurface::finishWalkData() {
     const Tri& t = leafTri_[i].t;
     nearTri_[i] = {t.a, t.b, t.c, t.b - t.a, t.c - t.a, t.c - t.b};
   }
+  nearPairs_.resize(leafTri_.size());
+  for (size_t i = 0; i < leafTri_.size(); ++i) {
+    const NearTri& t = nearTri_[i];
+    NearPairs& pp = nearPairs_[i];
+    for (int k = 0; k < 3; ++k) {
+      pp.a[k][0] = pp.a[k][1] = t.a[k];
+      pp.b[k][0] = pp.b[k][1] = t.b[k];
+      pp.c[k][0] = pp.c[k][1] = t.c[k];
+      pp.e[k][0] = t.ab[k];
+      pp.e[k][1] = t.ac[k];
+    }
+  }
   planePairs_.resize(leafTri_.size());
   for (size_t i = 0; i < leafTri_.size(); ++i) {
     const Tri& t = leafTri_[i].t;
@@ -410,6 +422,43 @@ inline Eigen::Vector3d closestPointWithEdges(const Eigen::Vector3d& p, const Eig
 }
 }  // namespace
 
+#if defined(__SSE2__)
+// closestPointWithEdges for the point with coordinates xx (each twice): the dot products in
+// pairs, (ab.dot(v), ac.dot(v)) for v = p - a, p - b, p - c, each summed as Eigen's 3-vector
+// dot, (e0 v0 + e1 v1) + e2 v2, from the same differences p - vertex: the same values, so the
+// same point bit for bit.
+#if defined(__GNUC__)
+__attribute__((always_inline))
+#endif
+inline Eigen::Vector3d CutSurface::closestPointPaired(const double* xx, int i) const {
+  const NearTri& t = nearTri_[i];
+  const NearPairs& pp = nearPairs_[i];
+  auto dots = [&](const double (*v)[2]) {
+    __m128d s[3];
+    for (int k = 0; k < 3; ++k)
+      s[k] = _mm_mul_pd(_mm_load_pd(pp.e[k]), _mm_sub_pd(_mm_load_pd(xx + 2 * k), _mm_load_pd(v[k])));
+    return _mm_add_pd(_mm_add_pd(s[0], s[1]), s[2]);
+  };
+  const __m128d d12 = dots(pp.a);
+  const double d1 = _mm_cvtsd_f64(d12), d2 = _mm_cvtsd_f64(_mm_unpackhi_pd(d12, d12));
+  if (d1 <= 0 && d2 <= 0) return t.a;
+  const __m128d d34 = dots(pp.b);
+  const double d3 = _mm_cvtsd_f64(d34), d4 = _mm_cvtsd_f64(_mm_unpackhi_pd(d34, d34));
+  if (d3 >= 0 && d4 <= d3) return t.b;
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return t.a + (d1 / (d1 - d3)) * t.ab;
+  const __m128d d56 = dots(pp.c);
+  const double d5 = _mm_cvtsd_f64(d56), d6 = _mm_cvtsd_f64(_mm_unpackhi_pd(d56, d56));
+  if (d6 >= 0 && d5 <= d6) return t.c;
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return t.a + (d2 / (d2 - d6)) * t.ac;
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) return t.b + ((d4 - d3) / ((d4 - d3) + (d5 - d6))) * t.bc;
+  const double denom = 1.0 / (va + vb + vc);
+  return t.a + t.ab * (vb * denom) + t.ac * (vc * denom);
+}
+#endif
+
 Eigen::Vector3d closestPointOnTriangle(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                                        const Eigen::Vector3d& c) {
   return closestPointOnTriangleInline(p, a, b, c);
@@ -453,10 +502,15 @@ double CutSurface::signedDistanceNear(const Eigen::Vector3d& x, double r, Eigen:
     if (node.left < 0) {
       id = -1;
       for (int i = node.begin; i < node.end; ++i) {
+#if defined(__SSE2__)
+        const Eigen::Vector3d q = closestPointPaired(xx, i);
+#else
         const NearTri& t = nearTri_[i];
         const Eigen::Vector3d q = closestPointWithEdges(x, t.a, t.b, t.c, t.ab, t.ac, t.bc);
+#endif
 #ifdef HYSIM_CHECK_EXACT
         {
+          const NearTri& t = nearTri_[i];
           const Eigen::Vector3d ref = closestPointOnTriangleInline(x, t.a, t.b, t.c);
           if (std::memcmp(ref.data(), q.data(), sizeof(double) * 3) != 0) std::abort();
         }
@@ -637,8 +691,20 @@ bool CutSurface::within(const Eigen::Vector3d& x, double r) const {
     if (node.left < 0) {
       id = -1;
       for (int i = node.begin; i < node.end; ++i) {
+#if defined(__SSE2__)
+        const Eigen::Vector3d q = closestPointPaired(xx, i);
+#else
         const NearTri& t = nearTri_[i];
-        if (std::sqrt((closestPointWithEdges(x, t.a, t.b, t.c, t.ab, t.ac, t.bc) - x).squaredNorm()) <= r) return true;
+        const Eigen::Vector3d q = closestPointWithEdges(x, t.a, t.b, t.c, t.ab, t.ac, t.bc);
+#endif
+#ifdef HYSIM_CHECK_EXACT
+        {
+          const NearTri& t = nearTri_[i];
+          const Eigen::Vector3d ref = closestPointOnTriangleInline(x, t.a, t.b, t.c);
+          if (std::memcmp(ref.data(), q.data(), sizeof(double) * 3) != 0) std::abort();
+        }
+#endif
+        if (std::sqrt((q - x).squaredNorm()) <= r) return true;
       }
     } else if (top + 2 <= 128) {
       // The nearer child first: a hit there ends the walk sooner.

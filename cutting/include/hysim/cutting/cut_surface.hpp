@@ -93,6 +93,11 @@ class CutSurface {
   struct NearTri {
     Eigen::Vector3d a, b, c, ab, ac, bc;
   };
+  // Per leaf triangle, its vertices axis by axis, each value twice, and (b - a, c - a) axis by
+  // axis: the nearest-point test takes two dot products with one vertex at once.
+  struct alignas(16) NearPairs {
+    double a[3][2], b[3][2], c[3][2], e[3][2];
+  };
   // Per leaf triangle, its first vertex and its normal axis by axis, each value twice: the
   // segment test measures both ends of a segment from the triangle's plane at once.
   struct alignas(16) PlanePairs {
@@ -113,7 +118,8 @@ class CutSurface {
   // triangles.
   void finish(const std::vector<Tri>& tri);
   int build(int begin, int end, BuildScratch& scratch);
-  // childBoxes_, nearTri_ and planePairs_ from nodes_ and leafTri_ (after the tree is built).
+  // childBoxes_, nearTri_, nearPairs_ and planePairs_ from nodes_ and leafTri_ (after the
+  // tree is built).
   void finishWalkData();
   // One step of a nearest-point walk at inner node `id` (see there); xx: the point's
   // coordinates, each twice (x0 x0 x1 x1 x2 x2, 16-byte aligned).
@@ -121,6 +127,9 @@ class CutSurface {
   // Which of inner node `id`'s children's boxes meet the box [lo, hi] (bit 0 left, bit 1 right);
   // lohi: lo's coordinates, then hi's, each twice (16-byte aligned).
   int childrenMeet(int id, const double* lohi) const;
+  // The nearest point of leaf triangle i (place in leafTri_) to the point xx (coordinates each
+  // twice, as stepChildren), as closestPointOnTriangle gives it (SSE2 builds).
+  Eigen::Vector3d closestPointPaired(const double* xx, int i) const;
 
   bool is_plane_ = true;
   Eigen::Vector3d point_ = Eigen::Vector3d::Zero(), normal_ = Eigen::Vector3d::UnitZ();
@@ -130,6 +139,7 @@ class CutSurface {
   std::vector<ChildBoxes> childBoxes_;  // by node id (a leaf's entry unused)
   std::vector<NearTri> nearTri_;        // by place in leafTri_
   std::vector<PlanePairs> planePairs_;  // by place in leafTri_
+  std::vector<NearPairs> nearPairs_;    // by place in leafTri_
   Eigen::AlignedBox3d bounds_;
 };
 
