@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
@@ -165,7 +166,9 @@ std::vector<EndCandidate> endCandidates(const std::vector<CrossedEdge>& crossed,
 // The output mesh is written once from them (Assemble).
 struct Work {
   std::vector<Vec3> X;             // #nodes: input rows (may move), then appended nodes
-  std::vector<Tet> T;              // #tets: input rows (modified in place), then appended tets
+  // #tets: input rows (modified in place), then appended tets (not zeroed as it grows: the
+  // constructor writes every input row, addTet the appended ones).
+  std::vector<Tet, NoInitAllocator<Tet>> T;
   std::vector<std::int32_t> extraMat;  // material of the appended tets
   int N0, M0;
 
@@ -219,7 +222,7 @@ inline std::uint64_t mix64(std::uint64_t x) {
 }
 int findLocal(const Tet& t, int v);
 template <class W>
-bool evenFacePairs(const W& w, int n, const std::vector<std::int32_t>& starOff, const std::vector<std::int32_t>& starTet) {
+bool evenFacePairs(const W& w, int n, const std::vector<std::int32_t>& starOff, const StarVector& starTet) {
   std::uint64_t acc = 0;
   for (int s = starOff[n]; s < starOff[n + 1]; ++s) {
     const auto& tv = w.tet(starTet[s]);
@@ -243,7 +246,7 @@ int findLocal(const Tet& t, int v) {
 void buildStarLists(const Tets& T, int numNodes, StarLists* lists) {
   const int M = static_cast<int>(T.rows());
   std::vector<std::int32_t>& off = lists->off;
-  std::vector<std::int32_t>& star = lists->star;
+  StarVector& star = lists->star;
   // Counts at off[n + 2], their prefix sums, then each tet at off[n + 1]++: afterwards
   // off[n] .. off[n + 1] is n's row (ascending: the tets in index order).
   off.assign(static_cast<size_t>(numNodes) + 2, 0);
@@ -274,10 +277,26 @@ void patchStarLists(const Tets& before, const Tets& after, int numNodesAfter, st
                     StarLists* lists) {
   const int M0 = static_cast<int>(before.rows()), M1 = static_cast<int>(after.rows());
   const int N0 = static_cast<int>(lists->off.size()) - 1;
-  std::sort(changed.begin(), changed.end());
-  changed.erase(std::unique(changed.begin(), changed.end()), changed.end());
-  std::vector<std::uint8_t> isChanged(M0, 0);
-  for (const int t : changed) isChanged[t] = 1;
+  // The changed rows sorted, without repeats (what sort + unique gives), from a bit per row
+  // (the words that got a bit, sorted, then each word's bits in order); the merge below reads
+  // the bits.
+  std::vector<std::uint64_t> changedBits(static_cast<size_t>(M0) / 64 + 1, 0);
+  {
+    std::vector<std::int32_t> words;
+    for (const int t : changed) {
+      std::uint64_t& word = changedBits[static_cast<size_t>(t) >> 6];
+      if (word == 0) words.push_back(t >> 6);
+      word |= std::uint64_t{1} << (t & 63);
+    }
+    std::sort(words.begin(), words.end());
+    changed.clear();
+    for (const int wi : words)
+      for (std::uint64_t word = changedBits[wi]; word; word &= word - 1)
+        changed.push_back(wi * 64 + std::countr_zero(word));
+  }
+  auto isChanged = [&changedBits](std::int32_t t) {
+    return ((changedBits[static_cast<size_t>(t) >> 6] >> (t & 63)) & 1) != 0;
+  };
   // The nodes whose lists change (those of the changed tets before and after, and of the
   // appended tets), numbered as met; for each, the changed and appended tets that have it
   // now (CSR over those numbers, ascending: the tets are visited in index order).
@@ -321,7 +340,7 @@ void patchStarLists(const Tets& before, const Tets& after, int numNodesAfter, st
     const std::int32_t* gEnd = gained.data() + gainedOff[i + 1];
     const size_t start = pool.size();
     for (;;) {
-      while (o < oEnd && isChanged[*o]) ++o;
+      while (o < oEnd && isChanged(*o)) ++o;
       const bool haveOld = o < oEnd, haveNew = g < gEnd;
       if (!haveOld && !haveNew) break;
       if (haveOld && (!haveNew || *o < *g)) {
@@ -505,7 +524,7 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
     buildStarLists(input.T, N0, &stars);
   }
   const std::vector<std::int32_t>& starOff = stars.off;
-  const std::vector<std::int32_t>& starTet = stars.star;
+  const StarVector& starTet = stars.star;
 
   auto crossingPoint = [&](const CrossedEdge& e) -> Vec3 {
     if (!plane) return e.point;
@@ -1082,10 +1101,11 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
 
   std::vector<std::int32_t> cutNodes;
   if (!cutFaceList.empty()) {
+    // (Sorted without repeats, as sort + unique, through a bit per node.)
+    IndexBits nodeBits(w.numNodes());
     for (const auto& key : cutFaceList)
-      for (int v : key.first.v) cutNodes.push_back(v);
-    std::sort(cutNodes.begin(), cutNodes.end());
-    cutNodes.erase(std::unique(cutNodes.begin(), cutNodes.end()), cutNodes.end());
+      for (int v : key.first.v) nodeBits.mark(v);
+    nodeBits.drainInto(cutNodes);
     std::vector<std::int32_t> slot(w.numNodes(), -1);
     for (size_t i = 0; i < cutNodes.size(); ++i) slot[cutNodes[i]] = static_cast<std::int32_t>(i);
     // Stars of the cut nodes within the local tets (CSR, each ascending: filled from the
@@ -1250,7 +1270,12 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
   std::iota(change.node_old_to_new.begin(), change.node_old_to_new.end(), 0);
   change.element_old_to_new.resize(M0);
   std::iota(change.element_old_to_new.begin(), change.element_old_to_new.end(), 0);
-  std::sort(splitOriginals.begin(), splitOriginals.end());
+  {  // (Each split original once: sorted through a bit per tet, as std::sort.)
+    IndexBits tetBits(M0);
+    for (const int o : splitOriginals) tetBits.mark(o);
+    splitOriginals.clear();
+    tetBits.drainInto(splitOriginals);
+  }
   // Added: the pieces of the split tets, i.e. each split original (its first piece keeps its
   // index) and every appended tet (the subdivision appends nothing else), ascending: the
   // originals (< M0) in order, then M0 .. M1-1.
@@ -1304,14 +1329,21 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
     report.flap_peeled = counts.flap_peeled;
     report.collapsed_edges = counts.collapsed;
     report.late_snaps = counts.late_snaps;
+    // (cutNodes is sorted: the added nodes sorted and merged in, as a sort of the whole.)
+    const auto mid = static_cast<std::ptrdiff_t>(cutNodes.size());
     cutNodes.insert(cutNodes.end(), counts.onto_cut.begin(), counts.onto_cut.end());
-    std::sort(cutNodes.begin(), cutNodes.end());
+    std::sort(cutNodes.begin() + mid, cutNodes.end());
+    std::inplace_merge(cutNodes.begin(), cutNodes.begin() + mid, cutNodes.end());
     report.peeled_volume = counts.peeled_volume;
     report.optimized_nodes = static_cast<int>(moved.size() - before);
     report.optimize_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - optStart).count();
   }
-  std::sort(moved.begin(), moved.end());
-  moved.erase(std::unique(moved.begin(), moved.end()), moved.end());
+  {  // (Sorted without repeats, as sort + unique, through a bit per node.)
+    IndexBits nodeBits(out.numNodes());
+    for (const int n : moved) nodeBits.mark(n);
+    moved.clear();
+    nodeBits.drainInto(moved);
+  }
   // Only surviving old nodes count as moved (new ones are described by new_nodes).
   for (int n : moved)
     if (n < N0) change.moved_nodes.push_back(n);

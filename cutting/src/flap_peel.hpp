@@ -31,7 +31,7 @@ StarShape starShape(const TetMesh& mesh, int v, const std::vector<std::int32_t>&
 // a row of the pool where the node's list was rebuilt after collapses.
 struct NodeStars {
   const std::vector<std::int32_t>& off;
-  const std::vector<std::int32_t>& star;
+  const StarVector& star;
   const std::vector<std::int32_t>& pool_start;  // -1: the CSR row
   const std::vector<std::int32_t>& pool_len;
   const std::vector<std::int32_t>& pool;

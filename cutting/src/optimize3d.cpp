@@ -135,7 +135,8 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   // everything else is local), live tets in index order. After edge collapses the lists of
   // the nodes whose tets died or changed are rebuilt (buildStars), into `ovrPool`; the others
   // keep their CSR rows.
-  std::vector<std::int32_t> off, star, ovrStart, ovrLen, ovrPool;
+  std::vector<std::int32_t> off, ovrStart, ovrLen, ovrPool;
+  StarVector star;
   bool built = false;
   if (region.stars != nullptr) {
     off.swap(region.stars->off);
@@ -574,7 +575,9 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   // goes away (compacted), which is fine.
   // linkOnly: only fill `link` (the boundary edges around v, up to the first face used by
   // more than two tets) and return whether the faces are; the loop check is skipped.
-  std::vector<std::int32_t> linkDeg, linkInc, tetLocal, faceKey;
+  // (Scratch that only grows, so that it is written without zeroing: tetLocal, faceKey,
+  // linkInc and discNbrs, v's neighbours in local number order.)
+  std::vector<std::int32_t> linkDeg, linkInc, tetLocal, faceKey, discNbrs;
   std::vector<std::uint16_t> faceUses;
   auto discAround = [&](int v, const std::vector<std::int32_t>& around, bool linkOnly = false) {
     link.clear();
@@ -583,10 +586,12 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     // count the pairs of each tet's other three nodes in a table over v's neighbours.
     // Each tet's three other nodes as local numbers (in the tet's order), read from the mesh
     // once.
-    nbrs.clear();
     const size_t n = around.size();
-    tetLocal.resize(3 * n + 1);  // (+1: a tet without v writes a fourth number)
-    bool threeEach = true;       // (every tet has v once: its three other nodes)
+    if (tetLocal.size() < 3 * n + 1) tetLocal.resize(3 * n + 1);  // (+1: a tet without v writes a fourth number)
+    if (discNbrs.size() < 4 * n) discNbrs.resize(4 * n);
+    std::int32_t* nb = discNbrs.data();
+    std::int32_t L = 0;     // neighbours numbered so far
+    bool threeEach = true;  // (every tet has v once: its three other nodes)
     for (size_t i = 0; i < n; ++i) {
       const int t = around[i];
       std::int32_t* o = &tetLocal[3 * i];
@@ -596,23 +601,22 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
         if (w == v) continue;
         std::int32_t& id = localId[w];
         if (id < 0) {
-          id = static_cast<std::int32_t>(nbrs.size());
-          nbrs.push_back(w);
+          id = L;
+          nb[L++] = w;
         }
         o[m++] = id;
       }
       threeEach = threeEach && m == 3;
     }
     if (!threeEach) {  // not a star of v (never so here)
-      for (int w : nbrs) localId[w] = -1;
+      for (std::int32_t i = 0; i < L; ++i) localId[nb[i]] = -1;
       return false;
     }
     // The faces at v of each tet, in the order of the face opposite each other node (faces
     // f != v's in order f = 0..3: without o[0], without o[1], without o[2]): the pairs
     // (o1, o2), (o0, o2), (o0, o1), each as its table index min * L + max.
-    const std::int32_t L = static_cast<std::int32_t>(nbrs.size());
     faceUses.assign(static_cast<size_t>(L) * L, 0);
-    faceKey.resize(3 * n);
+    if (faceKey.size() < 3 * n) faceKey.resize(3 * n);
     for (size_t i = 0; i < n; ++i) {
       const std::int32_t* o = &tetLocal[3 * i];
       std::int32_t* key = &faceKey[3 * i];
@@ -642,7 +646,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
         }
       }
     }
-    for (int w : nbrs) localId[w] = -1;
+    for (std::int32_t i = 0; i < L; ++i) localId[nb[i]] = -1;
     if (!manifold || link.empty() || linkOnly) return manifold;  // (link.empty(): an interior node)
     // One closed loop: every link vertex has degree 2, and walking from one edge visits all.
     // Each link vertex's (first two) edges in a table over v's neighbours: with all degrees 2
@@ -650,7 +654,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     // they form one loop.
     const size_t edges = link.size() / 2;
     linkDeg.assign(L, 0);
-    linkInc.resize(2 * static_cast<size_t>(L));
+    if (linkInc.size() < 2 * static_cast<size_t>(L)) linkInc.resize(2 * static_cast<size_t>(L));
     for (size_t i = 0; i < link.size(); ++i) {
       const std::int32_t id = link[i];
       if (linkDeg[id] < 2) linkInc[2 * id + linkDeg[id]] = static_cast<std::int32_t>(i / 2);
@@ -710,14 +714,38 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       added.drainInto(seeds);
     }
   }
-  // The live tets around the seeds, each once, in index order.
+  // The live tets around the seeds, each once, in index order (the live tets with a seed
+  // node). Kept (regionKept) with topoClock's value when found: while no tet has taken other
+  // nodes since (topoClock counts the writes of tets' nodes) and none came alive (only a
+  // written slot or an undone removal does, and no one asks between a removal and its undo),
+  // the list is the kept one without the tets that died since.
   IndexBits tetBits(M);
+  std::vector<std::int32_t> regionKept;
+  std::uint64_t topoClock = 0, regionClock = ~std::uint64_t{0};
   auto regionTets = [&](std::vector<std::int32_t>& out) {
     out.clear();
+    if (regionClock == topoClock) {
+      size_t kept = 0;
+      for (const std::int32_t t : regionKept)
+        if (!(*dead)[t]) regionKept[kept++] = t;
+      regionKept.resize(kept);
+      out.assign(regionKept.begin(), regionKept.end());
+#ifdef HYSIM_CHECK_EXACT
+      std::vector<std::int32_t> ref;
+      for (int n : seeds)
+        for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s)
+          if (!(*dead)[*s]) tetBits.mark(*s);
+      tetBits.drainInto(ref);
+      if (ref != out) std::abort();
+#endif
+      return;
+    }
     for (int n : seeds)
       for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s)
         if (!(*dead)[*s]) tetBits.mark(*s);
     tetBits.drainInto(out);
+    regionKept.assign(out.begin(), out.end());
+    regionClock = topoClock;
   };
   std::vector<std::int32_t> peelStamp, failedAt;
   int peelCount = 0;
@@ -832,6 +860,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       return radiusRatioOriented(pos(a), pos(b), pos(c), pos(d));  // -1 unless vol6(a, b, c, d) > 0
     };
     auto setTet = [&](int t, int a, int b, int c, int d) {
+      ++topoClock;
       flipChanged.push_back(t);
       const int v[4] = {a, b, c, d};
       for (int k = 0; k < 4; ++k) {
@@ -1271,24 +1300,47 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       {
         const double q = tetQ(t);
         if (lastResort && !(q < options.flap_quality)) return;
-        double mean = 0, lens[6];
-        const Vec3 p[4] = {pos(mesh.T(t, 0)), pos(mesh.T(t, 1)), pos(mesh.T(t, 2)), pos(mesh.T(t, 3))};
-        for (int a = 0, e = 0; a < 4; ++a)
-          for (int b = a + 1; b < 4; ++b, ++e) {
-            lens[e] = (p[a] - p[b]).norm();
-            mean += lens[e] / 6.0;
-          }
+        // Edge lengths as Eigen's norm() of p[a] - p[b]: the square root of ((x x + y y) + z z),
+        // in scalars over the coordinate columns.
+        double sq[6], lens[6];
+        {
+          const double* cx = mesh.X.col(0).data();
+          const double* cy = mesh.X.col(1).data();
+          const double* cz = mesh.X.col(2).data();
+          const int i[4] = {mesh.T(t, 0), mesh.T(t, 1), mesh.T(t, 2), mesh.T(t, 3)};
+          for (int a = 0, e = 0; a < 4; ++a)
+            for (int b = a + 1; b < 4; ++b, ++e) {
+              const double dx = cx[i[a]] - cx[i[b]], dy = cy[i[a]] - cy[i[b]], dz = cz[i[a]] - cz[i[b]];
+              sq[e] = (dx * dx + dy * dy) + dz * dz;
+            }
+        }
         // A tet at or above quality_target has only its short edges: none where the shortest
         // is not below collapse_fraction x the longest (a bound on the mean: the six rounded
         // sixths add up to at most hi (1 + 6 eps) < hi (1 + 1e-9)) or the local edge.
+        // (sqrt is correctly rounded, so monotone: the shortest and longest lengths are the
+        // roots of the smallest and largest squares; the other four are taken only past here.)
         if (q >= options.quality_target) {
-          double lo = lens[0], hi = lens[0];
+          double lo2 = sq[0], hi2 = sq[0];
           for (int e = 1; e < 6; ++e) {
-            lo = std::min(lo, lens[e]);
-            hi = std::max(hi, lens[e]);
+            lo2 = std::min(lo2, sq[e]);
+            hi2 = std::max(hi2, sq[e]);
           }
+          const double lo = std::sqrt(lo2), hi = std::sqrt(hi2);
           if (lo >= options.collapse_fraction * std::max(hi * (1 + 1e-9), region.edge_length)) return;
         }
+        double mean = 0;
+        for (int e = 0; e < 6; ++e) {
+          lens[e] = std::sqrt(sq[e]);
+          mean += lens[e] / 6.0;
+        }
+#ifdef HYSIM_CHECK_EXACT
+        const Vec3 p[4] = {pos(mesh.T(t, 0)), pos(mesh.T(t, 1)), pos(mesh.T(t, 2)), pos(mesh.T(t, 3))};
+        for (int a = 0, e = 0; a < 4; ++a)
+          for (int b = a + 1; b < 4; ++b, ++e) {
+            const double ref = (p[a] - p[b]).norm();
+            if (std::memcmp(&ref, &lens[e], sizeof ref) != 0) std::abort();
+          }
+#endif
         for (int a = 0, e = 0; a < 4; ++a)
           for (int b = a + 1; b < 4; ++b, ++e) {
             const int x = mesh.T(t, a), y = mesh.T(t, b);
@@ -1542,6 +1594,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
           continue;
         }
         // Apply, check manifoldness around v and the other nodes of the removed tets, or undo.
+        ++topoClock;
         for (int t : dying) kill(t);
         touch(u);
         touch(v);

@@ -5,6 +5,9 @@
 #include <algorithm>
 #include <bit>
 #include <cstdint>
+#include <memory>
+#include <new>
+#include <utility>
 #include <vector>
 
 #include "hysim/cutting/cut3d.hpp"
@@ -36,10 +39,34 @@ struct IndexBits {
   std::vector<std::int32_t> words;
 };
 
+// std::allocator, except that a value-initialisation (what resize(n) does to new elements)
+// leaves them default-initialised: new ints are not zeroed, for arrays that are written in
+// full right after they grow (the node->tet lists' `star`: 4 x #T entries per cut).
+template <class T>
+struct NoInitAllocator : std::allocator<T> {
+  template <class U>
+  struct rebind {
+    using other = NoInitAllocator<U>;
+  };
+  NoInitAllocator() = default;
+  template <class U>
+  NoInitAllocator(const NoInitAllocator<U>&) noexcept {}
+  template <class U>
+  void construct(U* p) noexcept {
+    ::new (static_cast<void*>(p)) U;
+  }
+  template <class U, class... Args>
+  void construct(U* p, Args&&... args) {
+    ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+  }
+};
+using StarVector = std::vector<std::int32_t, NoInitAllocator<std::int32_t>>;
+
 // Node -> tet lists of a tet mesh (each list ascending): CSR rows (off, star), or, where
 // pool_start[n] >= 0, pool_len[n] entries of `pool` from there.
 struct StarLists {
-  std::vector<std::int32_t> off, star;
+  std::vector<std::int32_t> off;
+  StarVector star;  // (not zeroed as it grows: buildStarLists writes every entry)
   std::vector<std::int32_t> pool_start, pool_len, pool;
 };
 // The CSR rows of all numNodes nodes of T (pool empty).

@@ -195,7 +195,7 @@ double topEigenvalue(const Model& m, const cutting::Positions& X, const std::vec
   struct Scratch {
     std::vector<int> local;
     std::vector<FreeSpring4> springs4;
-    std::vector<double> held_block, cols, u4, z4;
+    std::vector<double> held_block, cols, u4, z4, root_mass;
   };
   thread_local Scratch scratch;
   std::vector<int>& local = scratch.local;
@@ -223,6 +223,10 @@ double topEigenvalue(const Model& m, const cutting::Positions& X, const std::vec
   if (!avx2) springs.reserve(static_cast<size_t>(count) * 7);
   std::vector<double>& held_block = scratch.held_block;  // xx yy zz xy yz zx per node, zeroed at its turn
   if (held_block.size() < 6 * static_cast<size_t>(count)) held_block.resize(6 * static_cast<size_t>(count));
+  // The square roots of the nodes' masses, once a node (the same values as taken per spring end).
+  std::vector<double>& root_mass = scratch.root_mass;
+  if (root_mass.size() < static_cast<size_t>(count)) root_mass.resize(static_cast<size_t>(count));
+  for (int k = 0; k < count; ++k) root_mass[k] = std::sqrt(m.mass[nodes[k]]);
   for (int k = 0; k < count; ++k) {
     const int node = nodes[k];
     std::fill_n(&held_block[6 * static_cast<size_t>(k)], 6, 0.0);  // only node k's own turn adds to it
@@ -239,7 +243,7 @@ double topEigenvalue(const Model& m, const cutting::Positions& X, const std::vec
         FreeSpring fs;
         fs.a = 3 * la;
         fs.b = 3 * lb;
-        const double ca = sk / std::sqrt(m.mass[a]), cb = sk / std::sqrt(m.mass[b]);
+        const double ca = sk / root_mass[la], cb = sk / root_mass[lb];
         for (int c = 0; c < 3; ++c) {
           fs.wa[c] = ca * d[c];
           fs.wb[c] = cb * d[c];
@@ -258,7 +262,7 @@ double topEigenvalue(const Model& m, const cutting::Positions& X, const std::vec
           springs.push_back(fs);
         }
       } else if (la == k || lb == k) {  // this node free, the other end held
-        const Eigen::RowVector3d w = d * (sk / std::sqrt(m.mass[node]));
+        const Eigen::RowVector3d w = d * (sk / root_mass[k]);
         double* h = &held_block[6 * static_cast<size_t>(k)];
         h[0] += w[0] * w[0];
         h[1] += w[1] * w[1];
@@ -543,25 +547,42 @@ Status prepareModelAfterCut3D(const Model& model, const cutting::TetMesh& before
                    " but the scene defines no material with that label"};
   }
   // Tets around each node (CSR).
-  // (`around` is written in full below: allocated without zero-filling it first.)
+  // (tv: the tets' nodes row by row, tv[4 t + k] = after.T(t, k), one cache line a tet for
+  // the look-ups by tet below; `around` is written in full below: allocated without
+  // zero-filling it first.)
   std::vector<int> off(static_cast<size_t>(N1) + 1, 0);
   const std::unique_ptr<int[]> around_storage(new int[4 * static_cast<size_t>(T1)]);
+  const std::unique_ptr<std::int32_t[]> tv_storage(new std::int32_t[4 * static_cast<size_t>(T1)]);
   int* const around = around_storage.get();
-  for (int t = 0; t < T1; ++t)
-    for (int k = 0; k < 4; ++k) ++off[after.T(t, k) + 1];
+  std::int32_t* const tv = tv_storage.get();
+  {
+    const std::int32_t* const c0 = after.T.col(0).data();
+    const std::int32_t* const c1 = after.T.col(1).data();
+    const std::int32_t* const c2 = after.T.col(2).data();
+    const std::int32_t* const c3 = after.T.col(3).data();
+    for (int t = 0; t < T1; ++t) {
+      std::int32_t* const row = tv + 4 * static_cast<size_t>(t);
+      row[0] = c0[t];
+      row[1] = c1[t];
+      row[2] = c2[t];
+      row[3] = c3[t];
+      for (int k = 0; k < 4; ++k) ++off[row[k] + 1];
+    }
+  }
+  auto node = [tv](int t, int k) { return tv[4 * static_cast<size_t>(t) + k]; };
   for (int i = 0; i < N1; ++i) off[i + 1] += off[i];
   {
     std::vector<int> fill(off.begin(), off.end() - 1);
     for (int t = 0; t < T1; ++t)
-      for (int k = 0; k < 4; ++k) around[fill[after.T(t, k)]++] = t;
+      for (int k = 0; k < 4; ++k) around[fill[node(t, k)]++] = t;
   }
   std::vector<double> volume(static_cast<size_t>(T1), std::nan(""));
   auto tetVolume = [&](int t) {
     if (std::isnan(volume[t])) {  // cutting::tetVolume's arithmetic, inlined
-      const Eigen::Vector3d x0 = after.X.row(after.T(t, 0));
-      const Eigen::Vector3d x1 = after.X.row(after.T(t, 1));
-      const Eigen::Vector3d x2 = after.X.row(after.T(t, 2));
-      const Eigen::Vector3d x3 = after.X.row(after.T(t, 3));
+      const Eigen::Vector3d x0 = after.X.row(node(t, 0));
+      const Eigen::Vector3d x1 = after.X.row(node(t, 1));
+      const Eigen::Vector3d x2 = after.X.row(node(t, 2));
+      const Eigen::Vector3d x3 = after.X.row(node(t, 3));
       volume[t] = (x1 - x0).dot((x2 - x0).cross(x3 - x0)) / 6.0;
     }
     return volume[t];
@@ -570,7 +591,7 @@ Status prepareModelAfterCut3D(const Model& model, const cutting::TetMesh& before
   // Touched nodes: their masses and the springs between them change.
   std::vector<std::uint8_t> touched(static_cast<size_t>(N1), 0);
   auto touchTet = [&](int t) {
-    for (int k = 0; k < 4; ++k) touched[after.T(t, k)] = 1;
+    for (int k = 0; k < 4; ++k) touched[node(t, k)] = 1;
   };
   for (const cutting::NewNode& nn : change.new_nodes)
     if (nn.id >= 0 && nn.id < N1) touched[nn.id] = 1;
@@ -607,7 +628,7 @@ Status prepareModelAfterCut3D(const Model& model, const cutting::TetMesh& before
     if (same) {
       std::array<int, 4> a{}, b{};
       for (int k = 0; k < 4; ++k) {
-        a[k] = after.T(t, k);
+        a[k] = node(t, k);
         b[k] = o2n[before.T(o, k)];
       }
       if (a != b) {  // the same nodes in another order are the same element
@@ -651,7 +672,7 @@ Status prepareModelAfterCut3D(const Model& model, const cutting::TetMesh& before
     for (int r = begin; r < end; ++r)
       for (int e = off[region_nodes[r]]; e < off[region_nodes[r] + 1]; ++e)
         for (int k = 0; k < 4; ++k) {
-          const int j = after.T(around[e], k);
+          const int j = node(around[e], k);
           if (!region[j]) {
             region[j] = 1;
             region_nodes.push_back(j);
@@ -679,7 +700,7 @@ Status prepareModelAfterCut3D(const Model& model, const cutting::TetMesh& before
       for (int e = off[j]; e < off[j + 1]; ++e) mass[j] += lumpedShare(around[e]);
   } else {
     for (int t = 0; t < T1; ++t) {
-      const int n0 = after.T(t, 0), n1 = after.T(t, 1), n2 = after.T(t, 2), n3 = after.T(t, 3);
+      const int n0 = node(t, 0), n1 = node(t, 1), n2 = node(t, 2), n3 = node(t, 3);
       if (!(region[n0] | region[n1] | region[n2] | region[n3])) continue;
       const double w = lumpedShare(t);
       if (region[n0]) mass[n0] += w;
@@ -723,81 +744,50 @@ Status prepareModelAfterCut3D(const Model& model, const cutting::TetMesh& before
   // The unchanged ones stay in the model's arrays (compacted in place by the second part,
   // once nothing can fail); `springs` collects the recomputed ones, which follow them.
   std::vector<CutUpdate3DPrepared::Spring>& springs = prepared->springs;
-  // Each (tet, edge) with both ends touched, sorted by (smaller node, larger node), an edge's
-  // tets in increasing order (the order buildModel sums them in): two stable counting sorts,
-  // by the larger node, then by the smaller.
-  struct EdgeOfTet {
-    int b, tet;
+  // Per touched node a in increasing order, the edges (a, b) to touched nodes b > a, in
+  // increasing b (buildModel's order), each summing its tets in increasing order (as
+  // buildModel does): a's tet list is in increasing order, so each b's sums are accumulated
+  // in that order, in a small table of a's neighbours (`slot`: b -> entry, -1 otherwise).
+  struct EdgeSum {
+    int b;
+    double ev, bev;
   };
-  constexpr int kTetEdges[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
-  std::vector<int> edge_tets_of;
-  auto touchesTwice = [&](int t) {
-    return touched[after.T(t, 0)] + touched[after.T(t, 1)] + touched[after.T(t, 2)] + touched[after.T(t, 3)] >= 2;
-  };
-  {
-    // Such tets lie around touched nodes: found from their tet lists when that is less work
-    // than a pass over all tets, then put in increasing order.
-    std::size_t touched_incidences = 0;
-    for (int r = 0; r < rep.touched_nodes; ++r)
-      touched_incidences += static_cast<std::size_t>(off[region_nodes[r] + 1] - off[region_nodes[r]]);
-    if (touched_incidences < static_cast<std::size_t>(T1) / 2) {
-      std::vector<std::uint8_t> seen(static_cast<size_t>(T1), 0);
-      for (int r = 0; r < rep.touched_nodes; ++r)
-        for (int e = off[region_nodes[r]]; e < off[region_nodes[r] + 1]; ++e) {
-          const int t = around[e];
-          if (seen[t]) continue;
-          seen[t] = 1;
-          if (touchesTwice(t)) edge_tets_of.push_back(t);
-        }
-      std::sort(edge_tets_of.begin(), edge_tets_of.end());
-    } else {
-      for (int t = 0; t < T1; ++t)
-        if (touchesTwice(t)) edge_tets_of.push_back(t);
-    }
-  }
-  std::vector<int> bucket(static_cast<size_t>(N1) + 1, 0), by_larger(static_cast<size_t>(N1) + 1, 0);
-  auto forTouchedEdges = [&](auto&& f) {
-    for (int t : edge_tets_of)
-      for (const auto& e : kTetEdges) {
-        const int a = after.T(t, e[0]), b = after.T(t, e[1]);
-        if (touched[a] && touched[b]) f(t, std::min(a, b), std::max(a, b));
-      }
-  };
-  forTouchedEdges([&](int, int a, int b) {
-    ++bucket[a + 1];
-    ++by_larger[b + 1];
-  });
-  for (int i = 0; i < N1; ++i) {
-    bucket[i + 1] += bucket[i];
-    by_larger[i + 1] += by_larger[i];
-  }
-  struct EdgeEnds {
-    int a, b, tet;
-  };
-  std::vector<EdgeEnds> by_b(static_cast<size_t>(bucket[N1]));
-  forTouchedEdges([&](int t, int a, int b) { by_b[by_larger[b]++] = {a, b, t}; });
-  std::vector<EdgeOfTet> edge_tets(static_cast<size_t>(bucket[N1]));
-  {
-    std::vector<int> fill(bucket.begin(), bucket.end() - 1);
-    for (const EdgeEnds& e : by_b) edge_tets[fill[e.a]++] = {e.b, e.tet};
-  }
+  std::vector<EdgeSum> edge_sums;
+  std::vector<int> slot(static_cast<size_t>(N1), -1);
   int recomputed = 0;
-  for (int a = 0; a < N1; ++a)
-    for (int i = bucket[a]; i < bucket[a + 1];) {
-      const int b = edge_tets[i].b;
-      double ev = 0.0, bev = 0.0;
-      for (; i < bucket[a + 1] && edge_tets[i].b == b; ++i) {
-        const int t = edge_tets[i].tet;
-        const double vol = tetVolume(t);
-        if (!(vol > 0.0)) return Error{"tet " + std::to_string(t) + " has non-positive volume " + std::to_string(vol)};
-        const Material& mat = model.materials[material[t]];
-        ev += mat.young_modulus_pa * vol;
-        bev += mat.stiffness_damping_s * mat.young_modulus_pa * vol;
+  for (int r = 0; r < rep.touched_nodes; ++r) {
+    const int a = region_nodes[r];
+    edge_sums.clear();
+    for (int e = off[a]; e < off[a + 1]; ++e) {
+      const int t = around[e];
+      const Material* mat = nullptr;
+      double vol = 0.0;
+      for (int k = 0; k < 4; ++k) {
+        const int b = node(t, k);
+        if (b <= a || !touched[b]) continue;
+        if (mat == nullptr) {
+          vol = tetVolume(t);
+          if (!(vol > 0.0)) return Error{"tet " + std::to_string(t) + " has non-positive volume " + std::to_string(vol)};
+          mat = &model.materials[material[t]];
+        }
+        int& at = slot[b];
+        if (at < 0) {
+          at = static_cast<int>(edge_sums.size());
+          edge_sums.push_back({b, 0.0, 0.0});
+        }
+        EdgeSum& sum = edge_sums[at];
+        sum.ev += mat->young_modulus_pa * vol;
+        sum.bev += mat->stiffness_damping_s * mat->young_modulus_pa * vol;
       }
-      const double len = (after.X.row(b) - after.X.row(a)).norm();
-      springs.push_back({a, b, len, ev / (len * len), bev / (len * len)});
+    }
+    for (const EdgeSum& sum : edge_sums) slot[sum.b] = -1;
+    std::sort(edge_sums.begin(), edge_sums.end(), [](const EdgeSum& x, const EdgeSum& y) { return x.b < y.b; });
+    for (const EdgeSum& sum : edge_sums) {
+      const double len = (after.X.row(sum.b) - after.X.row(a)).norm();
+      springs.push_back({a, sum.b, len, sum.ev / (len * len), sum.bev / (len * len)});
       ++recomputed;
     }
+  }
   rep.springs_recomputed = recomputed;
   prepared->num_nodes_before = N0;
   prepared->mass = std::move(mass);
