@@ -76,6 +76,47 @@ void CutSurface::finish(const std::vector<Tri>& tri) {
     const Tri& t = tri[order_[i]];
     leafTri_.push_back({t, t.n.dot((t.b - t.a).cross(t.c - t.a))});
   }
+  finishWalkData();
+}
+
+void CutSurface::finishWalkData() {
+  childBoxes_.assign(nodes_.size(), ChildBoxes{});
+  for (size_t id = 0; id < nodes_.size(); ++id) {
+    const Node& node = nodes_[id];
+    if (node.left < 0) continue;
+    ChildBoxes& c = childBoxes_[id];
+    for (int k = 0; k < 3; ++k) {
+      c.lo[k][0] = nodes_[node.left].box.min()[k];
+      c.lo[k][1] = nodes_[node.right].box.min()[k];
+      c.hi[k][0] = nodes_[node.left].box.max()[k];
+      c.hi[k][1] = nodes_[node.right].box.max()[k];
+    }
+  }
+  nearTri_.resize(leafTri_.size());
+  for (size_t i = 0; i < leafTri_.size(); ++i) {
+    const Tri& t = leafTri_[i].t;
+    nearTri_[i] = {t.a, t.b, t.c, t.b - t.a, t.c - t.a, t.c - t.b};
+  }
+  nearPairs_.resize(leafTri_.size());
+  for (size_t i = 0; i < leafTri_.size(); ++i) {
+    const NearTri& t = nearTri_[i];
+    NearPairs& pp = nearPairs_[i];
+    for (int k = 0; k < 3; ++k) {
+      pp.a[k][0] = pp.a[k][1] = t.a[k];
+      pp.b[k][0] = pp.b[k][1] = t.b[k];
+      pp.c[k][0] = pp.c[k][1] = t.c[k];
+      pp.e[k][0] = t.ab[k];
+      pp.e[k][1] = t.ac[k];
+    }
+  }
+  planePairs_.resize(leafTri_.size());
+  for (size_t i = 0; i < leafTri_.size(); ++i) {
+    const Tri& t = leafTri_[i].t;
+    for (int k = 0; k < 3; ++k) {
+      planePairs_[i].p0[k][0] = planePairs_[i].p0[k][1] = t.a[k];
+      planePairs_[i].n[k][0] = planePairs_[i].n[k][1] = t.n[k];
+    }
+  }
 }
 
 Result<CutSurface> CutSurface::triangles(const Positions& X, const Tris& F) {
@@ -152,6 +193,7 @@ Result<CutSurface> CutSurface::strip(const Positions& X, int rows, int row_size)
     const Tri& t = (*tri)[k];
     s.leafTri_.push_back({t, t.n.dot((t.b - t.a).cross(t.c - t.a))});
   }
+  s.finishWalkData();
   return s;
 }
 
@@ -240,24 +282,6 @@ inline double boxDistance2(const Eigen::AlignedBox3d& box, const Eigen::Vector3d
 #endif
 }
 
-// The children of an inner node whose boxes lie within `limit` (squared distance) of x onto
-// the walk's stack with their box distances, the nearer last (so popped first).
-template <class Node>
-inline void pushChildren(const std::vector<Node>& nodes, const Node& node, const Eigen::Vector3d& x, double limit,
-                         int* stack, double* stackDist, int& top) {
-  const double dl = boxDistance2(nodes[node.left].box, x), dr = boxDistance2(nodes[node.right].box, x);
-  const bool leftFirst = dl <= dr;
-  const double dFar = leftFirst ? dr : dl, dNear = leftFirst ? dl : dr;
-  if (dFar <= limit) {
-    stack[top] = leftFirst ? node.right : node.left;
-    stackDist[top++] = dFar;
-  }
-  if (dNear <= limit) {
-    stack[top] = leftFirst ? node.left : node.right;
-    stackDist[top++] = dNear;
-  }
-}
-
 // AlignedBox::intersects for two non-empty boxes (min <= max on every axis).
 inline bool boxesMeet(const Eigen::AlignedBox3d& box, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
   return box.min()[0] <= hi[0] && lo[0] <= box.max()[0] && box.min()[1] <= hi[1] && lo[1] <= box.max()[1] &&
@@ -294,6 +318,147 @@ inline Eigen::Vector3d closestPointOnTriangleInline(const Eigen::Vector3d& p, co
 }
 }  // namespace
 
+// Both children's box distances at once: per lane the terms of boxDistance2 in its order,
+// ((x^2 + y^2) + z^2 with each term max(min - p, 0) + max(p - max, 0)), so the same values bit
+// for bit. The farther child onto the stack when within `limit`; the nearer one returned when
+// within it (-1 otherwise): the walk visits it next, as when it was pushed last and popped at
+// once (its check when popped, distance > limit, failed then: the limit had not changed).
+#if defined(__GNUC__)
+__attribute__((always_inline))
+#endif
+inline int CutSurface::stepChildren(int id, const double* xx, double limit, int* stack, double* stackDist,
+                                     int& top) const {
+  const Node& node = nodes_[id];
+  double dl, dr;
+#if !defined(__SSE2__) || defined(HYSIM_CHECK_EXACT)
+  const Eigen::Vector3d x(xx[0], xx[2], xx[4]);
+#endif
+#if defined(__SSE2__)
+  const ChildBoxes& c = childBoxes_[id];
+  const __m128d zero = _mm_setzero_pd();
+  __m128d aux[3];
+  for (int k = 0; k < 3; ++k) {
+    const __m128d p = _mm_load_pd(xx + 2 * k);
+    const __m128d below = _mm_sub_pd(_mm_load_pd(c.lo[k]), p), above = _mm_sub_pd(p, _mm_load_pd(c.hi[k]));
+    aux[k] = _mm_add_pd(_mm_max_pd(below, zero), _mm_max_pd(above, zero));
+  }
+  const __m128d sum = _mm_add_pd(_mm_add_pd(_mm_mul_pd(aux[0], aux[0]), _mm_mul_pd(aux[1], aux[1])),
+                                 _mm_mul_pd(aux[2], aux[2]));
+  dl = _mm_cvtsd_f64(sum);
+  dr = _mm_cvtsd_f64(_mm_unpackhi_pd(sum, sum));
+#ifdef HYSIM_CHECK_EXACT
+  {
+    const double rl = boxDistance2(nodes_[node.left].box, x), rr = boxDistance2(nodes_[node.right].box, x);
+    if (std::memcmp(&rl, &dl, sizeof dl) != 0 || std::memcmp(&rr, &dr, sizeof dr) != 0) std::abort();
+  }
+#endif
+#else
+  dl = boxDistance2(nodes_[node.left].box, x);
+  dr = boxDistance2(nodes_[node.right].box, x);
+#endif
+  const bool leftFirst = dl <= dr;
+  const double dFar = leftFirst ? dr : dl, dNear = leftFirst ? dl : dr;
+  if (dFar <= limit) {
+    stack[top] = leftFirst ? node.right : node.left;
+    stackDist[top++] = dFar;
+  }
+  return dNear <= limit ? (leftFirst ? node.left : node.right) : -1;
+}
+
+// Which of inner node id's children's boxes meet the box [lo, hi] (bit 0: the left, bit 1: the
+// right): boxesMeet's comparisons (min <= hi and lo <= max on every axis, false with a NaN),
+// for both children at once.
+#if defined(__GNUC__)
+__attribute__((always_inline))
+#endif
+inline int CutSurface::childrenMeet(int id, const double* lohi) const {
+#if !defined(__SSE2__) || defined(HYSIM_CHECK_EXACT)
+  const Eigen::Vector3d lo(lohi[0], lohi[2], lohi[4]), hi(lohi[6], lohi[8], lohi[10]);
+#endif
+#if defined(__SSE2__)
+  const ChildBoxes& c = childBoxes_[id];
+  __m128d meets[3];
+  for (int k = 0; k < 3; ++k)
+    meets[k] = _mm_and_pd(_mm_cmple_pd(_mm_load_pd(c.lo[k]), _mm_load_pd(lohi + 6 + 2 * k)),
+                          _mm_cmple_pd(_mm_load_pd(lohi + 2 * k), _mm_load_pd(c.hi[k])));
+  const int mask = _mm_movemask_pd(_mm_and_pd(_mm_and_pd(meets[0], meets[1]), meets[2]));
+#ifdef HYSIM_CHECK_EXACT
+  if (mask != (int(boxesMeet(nodes_[nodes_[id].left].box, lo, hi)) | int(boxesMeet(nodes_[nodes_[id].right].box, lo, hi)) << 1))
+    std::abort();
+#endif
+  return mask;
+#else
+  return int(boxesMeet(nodes_[nodes_[id].left].box, lo, hi)) | int(boxesMeet(nodes_[nodes_[id].right].box, lo, hi)) << 1;
+#endif
+}
+
+namespace {
+// closestPointOnTriangleInline with b - a, c - a and c - b given (as it computes them): the
+// same arithmetic on the same values, so the same point bit for bit.
+#if defined(__GNUC__)
+__attribute__((always_inline))
+#endif
+inline Eigen::Vector3d closestPointWithEdges(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
+                                             const Eigen::Vector3d& b, const Eigen::Vector3d& c,
+                                             const Eigen::Vector3d& ab, const Eigen::Vector3d& ac,
+                                             const Eigen::Vector3d& bc) {
+  const Eigen::Vector3d ap = p - a;
+  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0 && d2 <= 0) return a;
+  const Eigen::Vector3d bp = p - b;
+  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0 && d4 <= d3) return b;
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return a + (d1 / (d1 - d3)) * ab;
+  const Eigen::Vector3d cp = p - c;
+  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0 && d5 <= d6) return c;
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return a + (d2 / (d2 - d6)) * ac;
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) return b + ((d4 - d3) / ((d4 - d3) + (d5 - d6))) * bc;
+  const double denom = 1.0 / (va + vb + vc);
+  return a + ab * (vb * denom) + ac * (vc * denom);
+}
+}  // namespace
+
+#if defined(__SSE2__)
+// closestPointWithEdges for the point with coordinates xx (each twice): the dot products in
+// pairs, (ab.dot(v), ac.dot(v)) for v = p - a, p - b, p - c, each summed as Eigen's 3-vector
+// dot, (e0 v0 + e1 v1) + e2 v2, from the same differences p - vertex: the same values, so the
+// same point bit for bit.
+#if defined(__GNUC__)
+__attribute__((always_inline))
+#endif
+inline Eigen::Vector3d CutSurface::closestPointPaired(const double* xx, int i) const {
+  const NearTri& t = nearTri_[i];
+  const NearPairs& pp = nearPairs_[i];
+  auto dots = [&](const double (*v)[2]) {
+    __m128d s[3];
+    for (int k = 0; k < 3; ++k)
+      s[k] = _mm_mul_pd(_mm_load_pd(pp.e[k]), _mm_sub_pd(_mm_load_pd(xx + 2 * k), _mm_load_pd(v[k])));
+    return _mm_add_pd(_mm_add_pd(s[0], s[1]), s[2]);
+  };
+  const __m128d d12 = dots(pp.a);
+  const double d1 = _mm_cvtsd_f64(d12), d2 = _mm_cvtsd_f64(_mm_unpackhi_pd(d12, d12));
+  if (d1 <= 0 && d2 <= 0) return t.a;
+  const __m128d d34 = dots(pp.b);
+  const double d3 = _mm_cvtsd_f64(d34), d4 = _mm_cvtsd_f64(_mm_unpackhi_pd(d34, d34));
+  if (d3 >= 0 && d4 <= d3) return t.b;
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return t.a + (d1 / (d1 - d3)) * t.ab;
+  const __m128d d56 = dots(pp.c);
+  const double d5 = _mm_cvtsd_f64(d56), d6 = _mm_cvtsd_f64(_mm_unpackhi_pd(d56, d56));
+  if (d6 >= 0 && d5 <= d6) return t.c;
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return t.a + (d2 / (d2 - d6)) * t.ac;
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) return t.b + ((d4 - d3) / ((d4 - d3) + (d5 - d6))) * t.bc;
+  const double denom = 1.0 / (va + vb + vc);
+  return t.a + t.ab * (vb * denom) + t.ac * (vc * denom);
+}
+#endif
+
 Eigen::Vector3d closestPointOnTriangle(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                                        const Eigen::Vector3d& c) {
   return closestPointOnTriangleInline(p, a, b, c);
@@ -318,19 +483,38 @@ double CutSurface::signedDistanceNear(const Eigen::Vector3d& x, double r, Eigen:
   Eigen::Vector3d bestPoint = x;
   // The stack holds each node with its box distance (computed when its parent pushed it: the
   // same value as computing it again when popped).
+  // (The walk is that of pushing the root, then popping a node, skipping it when its distance
+  // is above best, else testing a leaf's triangles or pushing an inner node's children within
+  // best, the nearer last; the nearer child, popped at once, is visited without the stack.)
   int stack[128];
   double stackDist[128];
   int top = 0;
-  stack[top] = 0;
-  stackDist[top++] = boxDistance2(nodes_[0].box, x);
-  while (top > 0) {
-    --top;
-    const Node& node = nodes_[stack[top]];
-    if (stackDist[top] > best) continue;  // (equal: a tie with a lower index may be there)
+  alignas(16) const double xx[6] = {x[0], x[0], x[1], x[1], x[2], x[2]};
+  int id = boxDistance2(nodes_[0].box, x) > best ? -1 : 0;
+  for (;;) {
+    if (id < 0) {
+      if (top == 0) break;
+      --top;
+      if (stackDist[top] > best) continue;  // (equal: a tie with a lower index may be there)
+      id = stack[top];
+    }
+    const Node& node = nodes_[id];
     if (node.left < 0) {
+      id = -1;
       for (int i = node.begin; i < node.end; ++i) {
-        const Tri& t = leafTri_[i].t;
-        const Eigen::Vector3d q = closestPointOnTriangleInline(x, t.a, t.b, t.c);
+#if defined(__SSE2__)
+        const Eigen::Vector3d q = closestPointPaired(xx, i);
+#else
+        const NearTri& t = nearTri_[i];
+        const Eigen::Vector3d q = closestPointWithEdges(x, t.a, t.b, t.c, t.ab, t.ac, t.bc);
+#endif
+#ifdef HYSIM_CHECK_EXACT
+        {
+          const NearTri& t = nearTri_[i];
+          const Eigen::Vector3d ref = closestPointOnTriangleInline(x, t.a, t.b, t.c);
+          if (std::memcmp(ref.data(), q.data(), sizeof(double) * 3) != 0) std::abort();
+        }
+#endif
         const double d2 = (q - x).squaredNorm();
         // (Ties: the lower triangle index, whatever the order of the walk.)
         if (d2 < best || (d2 == best && order_[i] < bestTri)) {
@@ -341,8 +525,10 @@ double CutSurface::signedDistanceNear(const Eigen::Vector3d& x, double r, Eigen:
         }
       }
     } else if (top + 2 <= 128) {
-      // The nearer child first (pushed last): a close triangle found early prunes the rest.
-      pushChildren(nodes_, node, x, best, stack, stackDist, top);
+      // The nearer child first: a close triangle found early prunes the rest.
+      id = stepChildren(id, xx, best, stack, stackDist, top);
+    } else {
+      id = -1;
     }
   }
   if (bestTri < 0 && std::isfinite(r)) return signedDistanceNear(x, std::numeric_limits<double>::infinity(), closest);
@@ -372,26 +558,58 @@ bool CutSurface::intersectSegment(const Eigen::Vector3d& a, const Eigen::Vector3
     return true;
   }
   const Eigen::Vector3d segLo = a.cwiseMin(b), segHi = a.cwiseMax(b);
+  alignas(16) const double ends[6] = {a[0], b[0], a[1], b[1], a[2], b[2]};  // a and b, axis by axis
+  alignas(16) const double segBox[12] = {segLo[0], segLo[0], segLo[1], segLo[1], segLo[2], segLo[2],
+                                         segHi[0], segHi[0], segHi[1], segHi[1], segHi[2], segHi[2]};
   bool found = false;
   double bestT = 2.0;
+  // (The walk of pushing the root when its box meets the segment's, then popping a node,
+  // testing a leaf's triangles or pushing an inner node's children whose boxes meet the
+  // segment's, the left first; the right child, popped at once, is visited without the stack.)
   int stack[128];
   int top = 0;
-  if (boxesMeet(nodes_[0].box, segLo, segHi)) stack[top++] = 0;
-  while (top > 0) {
-    const Node& node = nodes_[stack[--top]];
+  int id = boxesMeet(nodes_[0].box, segLo, segHi) ? 0 : -1;
+  for (;;) {
+    if (id < 0) {
+      if (top == 0) break;
+      id = stack[--top];
+    }
+    const Node& node = nodes_[id];
     if (node.left < 0) {
+      id = -1;
       for (int i = node.begin; i < node.end; ++i) {
         const Tri& tr = leafTri_[i].t;
         double t, da, db;
+#if defined(__SSE2__)
+        {
+          // tryPlane with both ends at once: lane 0 a, lane 1 b, each n.dot(end - p0) as Eigen's
+          // 3-vector dot sums it, (n0 d0 + n1 d1) + n2 d2, so the same values bit for bit.
+          const PlanePairs& pp = planePairs_[i];
+          __m128d d[3];
+          for (int k = 0; k < 3; ++k)
+            d[k] = _mm_mul_pd(_mm_load_pd(pp.n[k]), _mm_sub_pd(_mm_load_pd(ends + 2 * k), _mm_load_pd(pp.p0[k])));
+          const __m128d dd = _mm_add_pd(_mm_add_pd(d[0], d[1]), d[2]);
+          da = _mm_cvtsd_f64(dd);
+          db = _mm_cvtsd_f64(_mm_unpackhi_pd(dd, dd));
+#ifdef HYSIM_CHECK_EXACT
+          const double ra = tr.n.dot(a - tr.a), rb = tr.n.dot(b - tr.a);
+          if (std::memcmp(&ra, &da, sizeof da) != 0 || std::memcmp(&rb, &db, sizeof db) != 0) std::abort();
+#endif
+          if (!((da > eps && db < -eps) || (da < -eps && db > eps))) continue;
+          t = da / (da - db);
+          if (t >= bestT) continue;
+        }
+#else
         if (!tryPlane(tr.n, tr.a, &t, &da, &db) || t >= bestT) continue;
+#endif
         const Eigen::Vector3d p = a + t * (b - a);
         // Inclusive inside test by signed sub-triangle areas along the normal.
         const double area = leafTri_[i].area;
         const double slack = -1e-12 * area;
-        const double w0 = tr.n.dot((tr.b - p).cross(tr.c - p));
-        const double w1 = tr.n.dot((tr.c - p).cross(tr.a - p));
-        const double w2 = tr.n.dot((tr.a - p).cross(tr.b - p));
-        if (w0 < slack || w1 < slack || w2 < slack) continue;
+        // (Each area tested as soon as it is known: the same values, fewer computed.)
+        if (tr.n.dot((tr.b - p).cross(tr.c - p)) < slack) continue;
+        if (tr.n.dot((tr.c - p).cross(tr.a - p)) < slack) continue;
+        if (tr.n.dot((tr.a - p).cross(tr.b - p)) < slack) continue;
         found = true;
         bestT = t;
         hit->t = t;
@@ -403,8 +621,15 @@ bool CutSurface::intersectSegment(const Eigen::Vector3d& a, const Eigen::Vector3
     } else if (top + 2 <= 128) {
       // Children whose boxes miss the segment's are not pushed (the same walk, in the same
       // order, as testing them when popped).
-      if (boxesMeet(nodes_[node.left].box, segLo, segHi)) stack[top++] = node.left;
-      if (boxesMeet(nodes_[node.right].box, segLo, segHi)) stack[top++] = node.right;
+      const int meet = childrenMeet(id, segBox);
+      if (meet == 3) {
+        stack[top++] = node.left;
+        id = node.right;
+      } else {
+        id = meet == 2 ? node.right : meet == 1 ? node.left : -1;
+      }
+    } else {
+      id = -1;
     }
   }
   return found;
@@ -420,18 +645,30 @@ bool CutSurface::mayTouch(const Eigen::AlignedBox3d& box, double eps) const {
   Eigen::Vector3d grownLo = box.min(), grownHi = box.max();
   grownLo.array() -= eps;
   grownHi.array() += eps;
-  // Down the tree: the box meets a leaf's box (a few triangles).
+  // Down the tree: the box meets a leaf's box (a few triangles). (Only nodes whose boxes meet
+  // it are visited, the right child before the left, as when both were pushed and tested when
+  // popped. The depth guard: a tree is at most about log2(triangles) + 2 deep, far below it.)
+  if (!boxesMeet(nodes_[0].box, grownLo, grownHi)) return false;
+  alignas(16) const double grownBox[12] = {grownLo[0], grownLo[0], grownLo[1], grownLo[1], grownLo[2], grownLo[2],
+                                           grownHi[0], grownHi[0], grownHi[1], grownHi[1], grownHi[2], grownHi[2]};
   int stack[128];
   int top = 0;
-  stack[top++] = 0;
-  while (top > 0) {
-    const Node& node = nodes_[stack[--top]];
-    if (!boxesMeet(node.box, grownLo, grownHi)) continue;
+  int id = 0;
+  for (;;) {
+    if (id < 0) {
+      if (top == 0) return false;
+      id = stack[--top];
+    }
+    const Node& node = nodes_[id];
     if (node.left < 0 || top + 2 > 128) return true;
-    stack[top++] = node.left;
-    stack[top++] = node.right;
+    const int meet = childrenMeet(id, grownBox);
+    if (meet == 3) {
+      stack[top++] = node.left;
+      id = node.right;
+    } else {
+      id = meet == 2 ? node.right : meet == 1 ? node.left : -1;
+    }
   }
-  return false;
 }
 
 bool CutSurface::within(const Eigen::Vector3d& x, double r) const {
@@ -441,20 +678,39 @@ bool CutSurface::within(const Eigen::Vector3d& x, double r) const {
   int stack[128];
   double stackDist[128];  // (as in signedDistanceNear)
   int top = 0;
-  stack[top] = 0;
-  stackDist[top++] = boxDistance2(nodes_[0].box, x);
-  while (top > 0) {
-    --top;
-    const Node& node = nodes_[stack[top]];
-    if (stackDist[top] > limit) continue;
+  alignas(16) const double xx[6] = {x[0], x[0], x[1], x[1], x[2], x[2]};
+  int id = boxDistance2(nodes_[0].box, x) > limit ? -1 : 0;
+  for (;;) {
+    if (id < 0) {
+      if (top == 0) break;
+      --top;
+      if (stackDist[top] > limit) continue;
+      id = stack[top];
+    }
+    const Node& node = nodes_[id];
     if (node.left < 0) {
+      id = -1;
       for (int i = node.begin; i < node.end; ++i) {
-        const Tri& t = leafTri_[i].t;
-        if (std::sqrt((closestPointOnTriangleInline(x, t.a, t.b, t.c) - x).squaredNorm()) <= r) return true;
+#if defined(__SSE2__)
+        const Eigen::Vector3d q = closestPointPaired(xx, i);
+#else
+        const NearTri& t = nearTri_[i];
+        const Eigen::Vector3d q = closestPointWithEdges(x, t.a, t.b, t.c, t.ab, t.ac, t.bc);
+#endif
+#ifdef HYSIM_CHECK_EXACT
+        {
+          const NearTri& t = nearTri_[i];
+          const Eigen::Vector3d ref = closestPointOnTriangleInline(x, t.a, t.b, t.c);
+          if (std::memcmp(ref.data(), q.data(), sizeof(double) * 3) != 0) std::abort();
+        }
+#endif
+        if (std::sqrt((q - x).squaredNorm()) <= r) return true;
       }
     } else if (top + 2 <= 128) {
-      // The nearer child first (pushed last): a hit there ends the walk sooner.
-      pushChildren(nodes_, node, x, limit, stack, stackDist, top);
+      // The nearer child first: a hit there ends the walk sooner.
+      id = stepChildren(id, xx, limit, stack, stackDist, top);
+    } else {
+      id = -1;
     }
   }
   return false;

@@ -1691,12 +1691,15 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     if (e.kind != 0 && e.x != pos(n)) e.kind = 0;
     return e;
   };
-  // |signed distance| of node n to the cut, and its nearest point.
-  auto nodeDistance = [&](int n, Vec3* closest) {
+  // |signed distance| of node n to the cut, and its nearest point. `within`: a distance n is
+  // known to be within (within() said so, or n is on the cut and `within` the on-surface
+  // tolerance), for the bounded search, which gives signedDistance's value and point (and
+  // searches everything after all where nothing is that near).
+  auto nodeDistance = [&](int n, Vec3* closest, double within = std::numeric_limits<double>::infinity()) {
     DistEntry& e = distEntry(n);
     if (e.kind != 1) {
       e.x = pos(n);
-      e.d = std::abs(region.surface->signedDistance(e.x, &e.closest));
+      e.d = std::abs(region.surface->signedDistanceNear(e.x, within, &e.closest));
       e.kind = 1;
     }
     if (closest) *closest = e.closest;
@@ -1728,7 +1731,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
         tried[u] = 1;
         const double limit = options.collapse_fraction * region.edge_length;
         if (!nodeWithin(u, limit)) continue;  // far: no nearest-point search
-        const double d = nodeDistance(u, nullptr);
+        const double d = nodeDistance(u, nullptr, limit);
         if (d < limit) cands.emplace_back(d, u);
       }
     std::sort(cands.begin(), cands.end());
@@ -1737,7 +1740,10 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     std::vector<std::uint64_t> targetEdges;
     std::vector<std::uint32_t> groupVer;
     const double near = options.collapse_fraction * region.edge_length;
-    auto inGroup = [&](int v) { return std::find(group.begin(), group.end(), v) != group.end(); };
+    // groupAt[v]: 1 + v's place in the group while trySnap runs (0: not in it; the group's
+    // nodes are distinct), for inGroup and the group's targets without a search.
+    std::vector<std::int8_t> groupAt(N, 0);
+    auto inGroup = [&](int v) { return groupAt[v] != 0; };
     // A retry (the group grown by a partner, nothing else changed: a failed trySnap leaves
     // everything as it was) takes the volume and q* of each changing tet without the new
     // member from the attempt before (prevGroup: its group size, 0 after a new group).
@@ -1747,7 +1753,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     // Moves the group onto the cut and removes the tets that go flat, if that passes the
     // checks; otherwise leaves everything as it was and names a near node (not on the cut, not
     // in the group) of the tet that failed, if there is one.
-    auto trySnap = [&](int* partner) {
+    auto trySnapMarked = [&](int* partner) {
       // The live tets of the group's stars, sorted, each once: each star is sorted, so a
       // merge of the runs (one node: its star as it is) gives what sort + unique gave.
       tets.clear();
@@ -1772,6 +1778,14 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       changing.clear();
       double oldMin = 1.0, newMin = 1.0, before = 0, after = 0;
       int worstTet = -1;
+      // The partner: a near node of the worst tet off the cut and not in the group (the last).
+      auto namePartner = [&](int* partner) {
+        for (int k = 0; k < 4; ++k) {
+          const int v = mesh.T(worstTet, k);
+          if (!onCut[v] && !inGroup(v) && nodeWithin(v, near) && nodeDistance(v, nullptr, near) < near)
+            *partner = v;
+        }
+      };
       matVol.clear();
       const bool reuse = prevGroup > 0 && prevGroup + 1 == group.size();
       const int added = reuse ? group.back() : -1;
@@ -1811,8 +1825,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
           for (int k = 0; k < 4; ++k) {
             const int v = mesh.T(t, k);
             p[k] = pos(v);
-            for (size_t g = 0; g < group.size(); ++g)
-              if (group[g] == v) p[k] = groupTo[g];
+            if (groupAt[v] != 0) p[k] = groupTo[groupAt[v] - 1];
           }
           vol = (p[1] - p[0]).dot((p[2] - p[0]).cross(p[3] - p[0])) / 6.0;
           q = vol > 0 ? radiusRatio(p[0], p[1], p[2], p[3]) : -1.0;
@@ -1823,6 +1836,14 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
         if (q < newMin) {
           newMin = q;
           worstTet = t;
+          // An inverted tet (q* -1, below every q* >= 0): the try fails and this is the worst
+          // tet whatever follows (a later one must be strictly worse). Without a partner from
+          // it, the caller ends the chain (nothing below is used: stop here).
+          if (q < 0 && !last) {
+            int p = -1;
+            namePartner(&p);
+            if (p < 0) return false;
+          }
         }
         after += vol;
         if (last && newMin < oldMin) return false;
@@ -1832,13 +1853,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       prevVol.swap(curVol);
       prevQ.swap(curQ);
       const double change = std::abs(after - before);
-      if (newMin < oldMin && worstTet >= 0) {
-        for (int k = 0; k < 4; ++k) {
-          const int v = mesh.T(worstTet, k);
-          if (!onCut[v] && !inGroup(v) && nodeWithin(v, near) && nodeDistance(v, nullptr) < near)
-            *partner = v;
-        }
-      }
+      if (newMin < oldMin && worstTet >= 0) namePartner(partner);
       if (dying.empty() || changing.empty() || newMin < oldMin ||
           change > options.collapse_volume_fraction * std::max(before, refVolume) || !budget.fits(after - before) ||
           !matFits(before)) {
@@ -1876,6 +1891,12 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       }
       budget.spend(after - before);
       return true;
+    };
+    auto trySnap = [&](int* partner) {
+      for (size_t g = 0; g < group.size(); ++g) groupAt[group[g]] = static_cast<std::int8_t>(g + 1);
+      const bool ok = trySnapMarked(partner);
+      for (int g : group) groupAt[g] = 0;
+      return ok;
     };
     for (const auto& [dist, u] : cands) {
       if (onCut[u]) continue;
@@ -2060,7 +2081,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       // y := its nearest point of the cut, which lies within |y - x| + dist(x) of y: the
       // search looks no farther (the same point as a full search).
       auto onCutAgain = [&](Vec3& y) {
-        const double r = (y - x).norm() + nodeDistance(n, nullptr);
+        const double r = (y - x).norm() + nodeDistance(n, nullptr, onCut[n] ? region.eps : std::numeric_limits<double>::infinity());
         region.surface->signedDistanceNear(Vec3(y), r, &y);
       };
       int farFromCut = curved && !onCut[n] ? -1 : 0;  // -1: not asked yet

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <limits>
 #include <random>
@@ -719,6 +720,140 @@ TEST(Cut3D, UterusHalfCylinderStripSeparatesCap) {
     // The faceted myoma and the coarse elements make the cap smaller than the exact one.
     EXPECT_GT(cap, 0.5 * analytic);
     EXPECT_LT(cap, 1.3 * analytic);
+  }
+}
+
+// The surface's walks (nearest point, within, segment crossing) against plain loops over every
+// triangle in input order, on random curved strips (a bent, wavy sheet, vertices jittered),
+// both trees (the strip's grid tree and the centroid-sorted one), at random points near and on
+// the surface: on triangles, on edges, at vertices, a little off them and farther out. The
+// nearest point and the signed distance agree bit for bit (ties: the lower triangle index).
+TEST(Cut3D, SurfaceWalksMatchBruteForce) {
+  std::mt19937 rng(20261123);
+  std::uniform_real_distribution<double> uni(0.0, 1.0);
+  for (int strip = 0; strip < 12; ++strip) {
+    const int rows = 2 + static_cast<int>(uni(rng) * 9), rowSize = 2 + static_cast<int>(uni(rng) * 25);
+    const double radius = 0.3 + uni(rng), bend = 0.5 + 2.5 * uni(rng), wave = 0.05 * uni(rng);
+    const double jitter = strip % 3 == 0 ? 0.0 : 0.01 * uni(rng);
+    Positions X(rows * rowSize, 3);
+    for (int r = 0; r < rows; ++r)
+      for (int i = 0; i < rowSize; ++i) {
+        const double a = bend * (static_cast<double>(i) / (rowSize - 1) - 0.5);
+        const double y = 1.5 * r / (rows - 1) + wave * std::sin(7.0 * a);
+        X.row(r * rowSize + i) << radius * std::sin(a) + jitter * (uni(rng) - 0.5),
+            y + jitter * (uni(rng) - 0.5), radius * (1 - std::cos(a)) + wave * std::cos(5.0 * y);
+      }
+    const Tris F = CutSurface::stripTriangles(rows, rowSize);
+    const auto grid = CutSurface::strip(X, rows, rowSize);
+    const auto sorted = CutSurface::triangles(X, F);
+    ASSERT_TRUE(grid.ok() && sorted.ok());
+    ASSERT_EQ(grid->numTriangles(), F.rows());  // none degenerate
+    auto vertex = [&](int f, int k) { return Vec3(X.row(F(f, k)).transpose()); };
+    // Brute force, in input order (a strictly smaller distance replaces: ties keep the lower index).
+    auto nearest = [&](const Vec3& x, Vec3* point) {
+      double best = std::numeric_limits<double>::infinity();
+      int bestF = -1;
+      for (int f = 0; f < F.rows(); ++f) {
+        const Vec3 q = closestPointOnTriangle(x, vertex(f, 0), vertex(f, 1), vertex(f, 2));
+        const double d2 = (q - x).squaredNorm();
+        if (d2 < best) {
+          best = d2;
+          bestF = f;
+          *point = q;
+        }
+      }
+      const Vec3 a = vertex(bestF, 0);
+      const Vec3 n = (vertex(bestF, 1) - a).cross(vertex(bestF, 2) - a).normalized();
+      const double d = std::sqrt(best);
+      return n.dot(x - a) < 0 ? -d : d;
+    };
+    auto within = [&](const Vec3& x, double r) {
+      for (int f = 0; f < F.rows(); ++f)
+        if (std::sqrt((closestPointOnTriangle(x, vertex(f, 0), vertex(f, 1), vertex(f, 2)) - x).squaredNorm()) <= r)
+          return true;
+      return false;
+    };
+    auto crossing = [&](const Vec3& a, const Vec3& b, double eps, double* tBest) {
+      bool found = false;
+      *tBest = 2.0;
+      for (int f = 0; f < F.rows(); ++f) {
+        const Vec3 p0 = vertex(f, 0), p1 = vertex(f, 1), p2 = vertex(f, 2);
+        const Vec3 n = (p1 - p0).cross(p2 - p0).normalized();
+        const double da = n.dot(a - p0), db = n.dot(b - p0);
+        if (!((da > eps && db < -eps) || (da < -eps && db > eps))) continue;
+        const double t = da / (da - db);
+        if (t >= *tBest) continue;
+        const Vec3 p = a + t * (b - a);
+        const double slack = -1e-12 * n.dot((p1 - p0).cross(p2 - p0));
+        if (n.dot((p1 - p).cross(p2 - p)) < slack || n.dot((p2 - p).cross(p0 - p)) < slack ||
+            n.dot((p0 - p).cross(p1 - p)) < slack)
+          continue;
+        found = true;
+        *tBest = t;
+      }
+      return found;
+    };
+    const Eigen::AlignedBox3d bounds = grid->bounds();
+    for (int i = 0; i < 400; ++i) {
+      const int f = static_cast<int>(uni(rng) * F.rows());
+      const Vec3 a = vertex(f, 0), b = vertex(f, 1), c = vertex(f, 2);
+      const Vec3 n = (b - a).cross(c - a).normalized();
+      Vec3 x;
+      switch (i % 6) {
+        case 0: x = i % 12 == 0 ? a : c; break;                      // a vertex
+        case 1: x = a + uni(rng) * (b - a); break;                    // an edge
+        case 2: {                                                     // in the triangle
+          double s = uni(rng), t = uni(rng);
+          if (s + t > 1) s = 1 - s, t = 1 - t;
+          x = a + s * (b - a) + t * (c - a);
+          break;
+        }
+        case 3: x = a + uni(rng) * (c - b) * 0.3 + std::pow(10.0, -12 + 11 * uni(rng)) * n; break;  // just off it
+        case 4: x = a + (uni(rng) - 0.5) * 0.2 * Vec3(uni(rng), uni(rng), uni(rng)); break;         // around it
+        default:                                                       // anywhere around the surface
+          x = bounds.min() + (bounds.max() - bounds.min()).cwiseProduct(Vec3(uni(rng), uni(rng), uni(rng))) * 1.4 -
+              0.2 * (bounds.max() - bounds.min());
+      }
+      Vec3 pRef;
+      const double dRef = nearest(x, &pRef);
+      for (const CutSurface* s : {&*grid, &*sorted}) {
+        Vec3 p;
+        const double d = s->signedDistance(x, &p);
+        EXPECT_EQ(std::memcmp(&d, &dRef, sizeof d), 0) << strip << " " << i << " " << d << " " << dRef;
+        EXPECT_EQ(std::memcmp(p.data(), pRef.data(), sizeof(double) * 3), 0) << strip << " " << i;
+        for (double r : {0.0, 0.5 * std::abs(dRef), std::abs(dRef), std::abs(dRef) * (1 + 1e-12) + 1e-300,
+                         2 * std::abs(dRef) + 0.01}) {
+          Vec3 pn;
+          const double dn = s->signedDistanceNear(x, r, &pn);
+          EXPECT_EQ(std::memcmp(&dn, &dRef, sizeof dn), 0) << strip << " " << i << " r " << r;
+          EXPECT_EQ(std::memcmp(pn.data(), pRef.data(), sizeof(double) * 3), 0) << strip << " " << i << " r " << r;
+        }
+        for (double r : {std::abs(dRef), std::abs(dRef) * (1 - 1e-9), std::abs(dRef) * (1 + 1e-9), 1e-3, 0.05})
+          EXPECT_EQ(s->within(x, r), within(x, r)) << strip << " " << i << " r " << r;
+        // A segment from x to a point across the surface (and one beside it).
+        for (const Vec3& y : {Vec3(pRef + (pRef - x) + 0.01 * n), Vec3(x + 0.3 * (b - a))}) {
+          double tRef;
+          const bool fRef = crossing(x, y, 1e-9, &tRef);
+          CutSurface::Hit hit;
+          const bool found = s->intersectSegment(x, y, 1e-9, &hit);
+          EXPECT_EQ(found, fRef) << strip << " " << i;
+          if (found && fRef) {
+            EXPECT_EQ(hit.t, tRef) << strip << " " << i;
+          }
+        }
+        // mayTouch: a box meeting a triangle's box is (possibly) touched.
+        const Eigen::AlignedBox3d box(x - Vec3::Constant(0.01), x + Vec3::Constant(0.01));
+        bool meets = false;
+        for (int g = 0; g < F.rows() && !meets; ++g) {
+          Eigen::AlignedBox3d tb;
+          tb.extend(vertex(g, 0)).extend(vertex(g, 1)).extend(vertex(g, 2));
+          meets = tb.intersects(box);
+        }
+        if (meets) {
+          EXPECT_TRUE(s->mayTouch(box, 0.0)) << strip << " " << i;
+        }
+      }
+    }
   }
 }
 

@@ -83,6 +83,26 @@ class CutSurface {
     int left = -1, right = -1;   // children; leaf when left < 0
     int begin = 0, end = 0;      // leaf: range in order_
   };
+  // Per inner node, its children's boxes axis by axis as (left, right) pairs: one step of a
+  // nearest-point walk measures both children with paired (SSE2) arithmetic.
+  struct alignas(16) ChildBoxes {
+    double lo[3][2], hi[3][2];
+  };
+  // Per leaf triangle, what the nearest-point searches read: its vertices, and b - a, c - a,
+  // c - b as closestPointOnTriangle computes them.
+  struct NearTri {
+    Eigen::Vector3d a, b, c, ab, ac, bc;
+  };
+  // Per leaf triangle, its vertices axis by axis, each value twice, and (b - a, c - a) axis by
+  // axis: the nearest-point test takes two dot products with one vertex at once.
+  struct alignas(16) NearPairs {
+    double a[3][2], b[3][2], c[3][2], e[3][2];
+  };
+  // Per leaf triangle, its first vertex and its normal axis by axis, each value twice: the
+  // segment test measures both ends of a segment from the triangle's plane at once.
+  struct alignas(16) PlanePairs {
+    double p0[3][2], n[3][2];
+  };
   struct LeafTri {
     Tri t;
     double area;  // t.n . ((b - a) x (c - a)), for the inside test of intersectSegment
@@ -98,12 +118,28 @@ class CutSurface {
   // triangles.
   void finish(const std::vector<Tri>& tri);
   int build(int begin, int end, BuildScratch& scratch);
+  // childBoxes_, nearTri_, nearPairs_ and planePairs_ from nodes_ and leafTri_ (after the
+  // tree is built).
+  void finishWalkData();
+  // One step of a nearest-point walk at inner node `id` (see there); xx: the point's
+  // coordinates, each twice (x0 x0 x1 x1 x2 x2, 16-byte aligned).
+  int stepChildren(int id, const double* xx, double limit, int* stack, double* stackDist, int& top) const;
+  // Which of inner node `id`'s children's boxes meet the box [lo, hi] (bit 0 left, bit 1 right);
+  // lohi: lo's coordinates, then hi's, each twice (16-byte aligned).
+  int childrenMeet(int id, const double* lohi) const;
+  // The nearest point of leaf triangle i (place in leafTri_) to the point xx (coordinates each
+  // twice, as stepChildren), as closestPointOnTriangle gives it (SSE2 builds).
+  Eigen::Vector3d closestPointPaired(const double* xx, int i) const;
 
   bool is_plane_ = true;
   Eigen::Vector3d point_ = Eigen::Vector3d::Zero(), normal_ = Eigen::Vector3d::UnitZ();
   std::vector<int> order_;        // tree order -> input triangle index
   std::vector<Node> nodes_;
   std::vector<LeafTri> leafTri_;  // the triangles in tree order: input triangle order_[i] at i
+  std::vector<ChildBoxes> childBoxes_;  // by node id (a leaf's entry unused)
+  std::vector<NearTri> nearTri_;        // by place in leafTri_
+  std::vector<PlanePairs> planePairs_;  // by place in leafTri_
+  std::vector<NearPairs> nearPairs_;    // by place in leafTri_
   Eigen::AlignedBox3d bounds_;
 };
 
