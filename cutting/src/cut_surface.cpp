@@ -289,34 +289,6 @@ inline bool boxesMeet(const Eigen::AlignedBox3d& box, const Eigen::Vector3d& lo,
 }
 }  // namespace
 
-namespace {
-// closestPointOnTriangle, inlined into the nearest-point searches (their leaf loops call it
-// millions of times): the same arithmetic, without the call.
-#if defined(__GNUC__)
-__attribute__((always_inline))
-#endif
-inline Eigen::Vector3d closestPointOnTriangleInline(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
-                                                    const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
-  // Voronoi-region walk (Ericson, Real-Time Collision Detection, 5.1.5).
-  const Eigen::Vector3d ab = b - a, ac = c - a, ap = p - a;
-  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
-  if (d1 <= 0 && d2 <= 0) return a;
-  const Eigen::Vector3d bp = p - b;
-  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
-  if (d3 >= 0 && d4 <= d3) return b;
-  const double vc = d1 * d4 - d3 * d2;
-  if (vc <= 0 && d1 >= 0 && d3 <= 0) return a + (d1 / (d1 - d3)) * ab;
-  const Eigen::Vector3d cp = p - c;
-  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
-  if (d6 >= 0 && d5 <= d6) return c;
-  const double vb = d5 * d2 - d1 * d6;
-  if (vb <= 0 && d2 >= 0 && d6 <= 0) return a + (d2 / (d2 - d6)) * ac;
-  const double va = d3 * d6 - d5 * d4;
-  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) return b + ((d4 - d3) / ((d4 - d3) + (d5 - d6))) * (c - b);
-  const double denom = 1.0 / (va + vb + vc);
-  return a + ab * (vb * denom) + ac * (vc * denom);
-}
-}  // namespace
 
 // Both children's box distances at once: per lane the terms of boxDistance2 in its order,
 // ((x^2 + y^2) + z^2 with each term max(min - p, 0) + max(p - max, 0)), so the same values bit
@@ -393,8 +365,10 @@ inline int CutSurface::childrenMeet(int id, const double* lohi) const {
 }
 
 namespace {
-// closestPointOnTriangleInline with b - a, c - a and c - b given (as it computes them): the
-// same arithmetic on the same values, so the same point bit for bit.
+// The nearest point of triangle (a, b, c) to p, by the Voronoi-region walk (Ericson,
+// Real-Time Collision Detection, 5.1.5), with its edges ab = b - a, ac = c - a, bc = c - b
+// given (the nearest-point searches read them from a table made with the tree); inlined into
+// their leaf loops, which call it millions of times.
 #if defined(__GNUC__)
 __attribute__((always_inline))
 #endif
@@ -419,6 +393,12 @@ inline Eigen::Vector3d closestPointWithEdges(const Eigen::Vector3d& p, const Eig
   if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) return b + ((d4 - d3) / ((d4 - d3) + (d5 - d6))) * bc;
   const double denom = 1.0 / (va + vb + vc);
   return a + ab * (vb * denom) + ac * (vc * denom);
+}
+
+// closestPointWithEdges with the edges computed here.
+inline Eigen::Vector3d closestPointOnTriangleInline(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
+                                                    const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
+  return closestPointWithEdges(p, a, b, c, b - a, c - a, c - b);
 }
 }  // namespace
 
@@ -458,6 +438,28 @@ inline Eigen::Vector3d CutSurface::closestPointPaired(const double* xx, int i) c
   return t.a + t.ab * (vb * denom) + t.ac * (vc * denom);
 }
 #endif
+
+#if defined(__GNUC__)
+__attribute__((always_inline))
+#endif
+inline Eigen::Vector3d CutSurface::nearestOnLeaf(const double* xx, const Eigen::Vector3d& x, int i) const {
+#if defined(__SSE2__)
+  (void)x;
+  const Eigen::Vector3d q = closestPointPaired(xx, i);
+#else
+  (void)xx;
+  const NearTri& t = nearTri_[i];
+  const Eigen::Vector3d q = closestPointWithEdges(x, t.a, t.b, t.c, t.ab, t.ac, t.bc);
+#endif
+#ifdef HYSIM_CHECK_EXACT
+  {
+    const NearTri& t = nearTri_[i];
+    const Eigen::Vector3d ref = closestPointOnTriangleInline(x, t.a, t.b, t.c);
+    if (std::memcmp(ref.data(), q.data(), sizeof(double) * 3) != 0) std::abort();
+  }
+#endif
+  return q;
+}
 
 Eigen::Vector3d closestPointOnTriangle(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                                        const Eigen::Vector3d& c) {
@@ -502,19 +504,7 @@ double CutSurface::signedDistanceNear(const Eigen::Vector3d& x, double r, Eigen:
     if (node.left < 0) {
       id = -1;
       for (int i = node.begin; i < node.end; ++i) {
-#if defined(__SSE2__)
-        const Eigen::Vector3d q = closestPointPaired(xx, i);
-#else
-        const NearTri& t = nearTri_[i];
-        const Eigen::Vector3d q = closestPointWithEdges(x, t.a, t.b, t.c, t.ab, t.ac, t.bc);
-#endif
-#ifdef HYSIM_CHECK_EXACT
-        {
-          const NearTri& t = nearTri_[i];
-          const Eigen::Vector3d ref = closestPointOnTriangleInline(x, t.a, t.b, t.c);
-          if (std::memcmp(ref.data(), q.data(), sizeof(double) * 3) != 0) std::abort();
-        }
-#endif
+        const Eigen::Vector3d q = nearestOnLeaf(xx, x, i);
         const double d2 = (q - x).squaredNorm();
         // (Ties: the lower triangle index, whatever the order of the walk.)
         if (d2 < best || (d2 == best && order_[i] < bestTri)) {
@@ -691,19 +681,7 @@ bool CutSurface::within(const Eigen::Vector3d& x, double r) const {
     if (node.left < 0) {
       id = -1;
       for (int i = node.begin; i < node.end; ++i) {
-#if defined(__SSE2__)
-        const Eigen::Vector3d q = closestPointPaired(xx, i);
-#else
-        const NearTri& t = nearTri_[i];
-        const Eigen::Vector3d q = closestPointWithEdges(x, t.a, t.b, t.c, t.ab, t.ac, t.bc);
-#endif
-#ifdef HYSIM_CHECK_EXACT
-        {
-          const NearTri& t = nearTri_[i];
-          const Eigen::Vector3d ref = closestPointOnTriangleInline(x, t.a, t.b, t.c);
-          if (std::memcmp(ref.data(), q.data(), sizeof(double) * 3) != 0) std::abort();
-        }
-#endif
+        const Eigen::Vector3d q = nearestOnLeaf(xx, x, i);
         if (std::sqrt((q - x).squaredNorm()) <= r) return true;
       }
     } else if (top + 2 <= 128) {

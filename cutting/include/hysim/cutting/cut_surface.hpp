@@ -130,6 +130,9 @@ class CutSurface {
   // The nearest point of leaf triangle i (place in leafTri_) to the point xx (coordinates each
   // twice, as stepChildren), as closestPointOnTriangle gives it (SSE2 builds).
   Eigen::Vector3d closestPointPaired(const double* xx, int i) const;
+  // The nearest point of leaf triangle i to x (xx: x's coordinates each twice): closestPointPaired
+  // in SSE2 builds, closestPointOnTriangle's arithmetic otherwise (the same point).
+  Eigen::Vector3d nearestOnLeaf(const double* xx, const Eigen::Vector3d& x, int i) const;
 
   bool is_plane_ = true;
   Eigen::Vector3d point_ = Eigen::Vector3d::Zero(), normal_ = Eigen::Vector3d::UnitZ();
