@@ -3,7 +3,6 @@
 
 #include <algorithm>
 #include <array>
-#include <bit>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
@@ -280,23 +279,11 @@ void patchStarLists(const Tets& before, const Tets& after, int numNodesAfter, st
   // The changed rows sorted, without repeats (what sort + unique gives), from a bit per row
   // (the words that got a bit, sorted, then each word's bits in order); the merge below reads
   // the bits.
-  std::vector<std::uint64_t> changedBits(static_cast<size_t>(M0) / 64 + 1, 0);
-  {
-    std::vector<std::int32_t> words;
-    for (const int t : changed) {
-      std::uint64_t& word = changedBits[static_cast<size_t>(t) >> 6];
-      if (word == 0) words.push_back(t >> 6);
-      word |= std::uint64_t{1} << (t & 63);
-    }
-    std::sort(words.begin(), words.end());
-    changed.clear();
-    for (const int wi : words)
-      for (std::uint64_t word = changedBits[wi]; word; word &= word - 1)
-        changed.push_back(wi * 64 + std::countr_zero(word));
-  }
-  auto isChanged = [&changedBits](std::int32_t t) {
-    return ((changedBits[static_cast<size_t>(t) >> 6] >> (t & 63)) & 1) != 0;
-  };
+  IndexBits changedBits(M0);
+  for (const int t : changed) changedBits.mark(t);
+  changed.clear();
+  changedBits.listInto(changed);
+  auto isChanged = [&changedBits](std::int32_t t) { return changedBits.has(t); };
   // The nodes whose lists change (those of the changed tets before and after, and of the
   // appended tets), numbered as met; for each, the changed and appended tets that have it
   // now (CSR over those numbers, ascending: the tets are visited in index order).

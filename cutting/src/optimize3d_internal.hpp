@@ -15,7 +15,7 @@
 namespace hysim::cutting {
 
 // A set of indices below n as a bit per index: mark() sets one (noting each word that gets
-// its first bit), drainInto() appends the set ones in increasing order (the sorted list without
+// its first bit), has() tests one, drainInto() appends the set ones in increasing order (the sorted list without
 // repeats, as sort + unique of what was marked) and clears them, so the bits are all zero
 // between uses.
 struct IndexBits {
@@ -25,12 +25,16 @@ struct IndexBits {
     if (word == 0) words.push_back(i >> 6);
     word |= std::uint64_t{1} << (i & 63);
   }
-  void drainInto(std::vector<std::int32_t>& out) {
+  bool has(int i) const { return ((bits[static_cast<size_t>(i) >> 6] >> (i & 63)) & 1) != 0; }
+  // Appends the set ones in increasing order and keeps them (has() still answers).
+  void listInto(std::vector<std::int32_t>& out) {
     std::sort(words.begin(), words.end());
-    for (const int wi : words) {
+    for (const int wi : words)
       for (std::uint64_t word = bits[wi]; word; word &= word - 1) out.push_back(wi * 64 + std::countr_zero(word));
-      bits[wi] = 0;
-    }
+  }
+  void drainInto(std::vector<std::int32_t>& out) {
+    listInto(out);
+    for (const int wi : words) bits[wi] = 0;
     words.clear();
   }
 
