@@ -840,18 +840,30 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     failedPrev.clear();
     failedNow.clear();
     std::vector<std::int32_t> cands, candsMerged, edgeAll;
-    // The live tets around t's nodes 0, 1 and 2 (star order; t among them), each with, per
-    // position l (4 bits each), the mask of t's nodes equal to its node l: the face and edge
-    // searches below read them instead of scanning the stars again. hitsOf(m, S): how many
-    // positions hold one of t's nodes in S (the count the scans took).
+    // The live tets around t's nodes 0, 1 and 2 (star order; t among them), each with the mask
+    // c of t's nodes it contains (bit k: t's node k is one of its nodes): the face and edge
+    // searches below read them instead of scanning the stars again. The scans counted the
+    // positions l of the tet whose node is one of t's nodes in S (hitsOf below, with m holding
+    // per position l, 4 bits each, the mask of t's nodes equal to node l). A live tet's four
+    // nodes are distinct and so are t's: each nibble of m has at most one bit and different
+    // nibbles have different bits, so that count is popcount(c & S) with c the OR of the
+    // nibbles; "count == |S|" is then (c & S) == S (checked under HYSIM_CHECK_EXACT).
     struct NearTet {
       std::int32_t s;
-      std::uint16_t m;
+      std::uint32_t c;
+#ifdef HYSIM_CHECK_EXACT
+      std::uint32_t m;
+#endif
     };
     std::vector<NearTet> nearTets;
+#ifdef HYSIM_CHECK_EXACT
     auto hitsOf = [](unsigned m, unsigned S) {
       return int((m & S) != 0) + int(((m >> 4) & S) != 0) + int(((m >> 8) & S) != 0) + int(((m >> 12) & S) != 0);
     };
+    auto checkHits = [&](const NearTet& nt, unsigned S, int need) {
+      if ((hitsOf(nt.m, S) == need) != ((nt.c & S) == S)) std::abort();
+    };
+#endif
     auto vol6 = [&](int a, int b, int c, int d) {
       const Vec3 p0 = pos(a);
       return (pos(b) - p0).dot((pos(c) - p0).cross(pos(d) - p0));
@@ -946,18 +958,29 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
             nearOff[i] = static_cast<int>(nearTets.size());
             for (const std::int32_t *s = starB(mesh.T(t, i)), *sEnd = starE(mesh.T(t, i)); s < sEnd; ++s) {
               if ((*dead)[*s]) continue;
-              unsigned m = 0;
-              for (int l = 0; l < 4; ++l) {
-                const int w = mesh.T(*s, l);
+              const int w0 = mesh.T(*s, 0), w1 = mesh.T(*s, 1), w2 = mesh.T(*s, 2), w3 = mesh.T(*s, 3);
 #if defined(__SSE2__)
-                const unsigned eq = static_cast<unsigned>(
-                    _mm_movemask_ps(_mm_castsi128_ps(_mm_cmpeq_epi32(_mm_set1_epi32(w), tNodes))));
-                m |= eq << (4 * l);
+              const __m128i eq = _mm_or_si128(
+                  _mm_or_si128(_mm_cmpeq_epi32(_mm_set1_epi32(w0), tNodes), _mm_cmpeq_epi32(_mm_set1_epi32(w1), tNodes)),
+                  _mm_or_si128(_mm_cmpeq_epi32(_mm_set1_epi32(w2), tNodes), _mm_cmpeq_epi32(_mm_set1_epi32(w3), tNodes)));
+              const unsigned c = static_cast<unsigned>(_mm_movemask_ps(_mm_castsi128_ps(eq)));
 #else
-                m |= (unsigned(w == t0) | unsigned(w == t1) << 1 | unsigned(w == t2) << 2 | unsigned(w == t3) << 3) << (4 * l);
+              const unsigned c = unsigned(w0 == t0 || w1 == t0 || w2 == t0 || w3 == t0) |
+                                 unsigned(w0 == t1 || w1 == t1 || w2 == t1 || w3 == t1) << 1 |
+                                 unsigned(w0 == t2 || w1 == t2 || w2 == t2 || w3 == t2) << 2 |
+                                 unsigned(w0 == t3 || w1 == t3 || w2 == t3 || w3 == t3) << 3;
 #endif
-              }
-              nearTets.push_back({*s, static_cast<std::uint16_t>(m)});
+#ifdef HYSIM_CHECK_EXACT
+              unsigned m = 0;
+              const int wl[4] = {w0, w1, w2, w3};
+              for (int l = 0; l < 4; ++l)
+                m |= (unsigned(wl[l] == t0) | unsigned(wl[l] == t1) << 1 | unsigned(wl[l] == t2) << 2 |
+                      unsigned(wl[l] == t3) << 3)
+                     << (4 * l);
+              nearTets.push_back({*s, c, m});
+#else
+              nearTets.push_back({*s, c});
+#endif
             }
           }
           nearOff[3] = static_cast<int>(nearTets.size());
@@ -970,11 +993,15 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
             edgeOff[e] = static_cast<int>(edgeAll.size());
             const unsigned S = (1u << i) | (1u << j);
             bool sameMat = true;
-            for (int k = nearOff[i]; k < nearOff[i + 1]; ++k)
-              if (hitsOf(nearTets[k].m, S) == 2) {
+            for (int k = nearOff[i]; k < nearOff[i + 1]; ++k) {
+#ifdef HYSIM_CHECK_EXACT
+              checkHits(nearTets[k], S, 2);
+#endif
+              if ((nearTets[k].c & S) == S) {
                 edgeAll.push_back(nearTets[k].s);
                 sameMat = sameMat && mesh.material(nearTets[k].s) == mesh.material(t);
               }
+            }
             edgeSameMat[e] = sameMat;
           }
         edgeOff[6] = static_cast<int>(edgeAll.size());
@@ -990,8 +1017,12 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
           {
             const int li = kFace[f][0];  // a = t's node li
             const unsigned S = (1u << kFace[f][0]) | (1u << kFace[f][1]) | (1u << kFace[f][2]);
-            for (int k = nearOff[li]; k < nearOff[li + 1] && u < 0; ++k)
-              if (nearTets[k].s != t && hitsOf(nearTets[k].m, S) == 3) u = nearTets[k].s;
+            for (int k = nearOff[li]; k < nearOff[li + 1] && u < 0; ++k) {
+#ifdef HYSIM_CHECK_EXACT
+              checkHits(nearTets[k], S, 3);
+#endif
+              if (nearTets[k].s != t && (nearTets[k].c & S) == S) u = nearTets[k].s;
+            }
           }
           if (u < 0 || mesh.material(u) != mesh.material(t)) continue;
           int e = -1;
