@@ -545,20 +545,53 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   // the mesh stays manifold: the boundary faces around each of its nodes still form one
   // closed loop (a disc), or the node had no other tet (it goes with the sliver). Its volume (tiny: it is flat) is lost.
   std::vector<std::int32_t> link;  // scratch: link edges of a node, as pairs (discAround's local numbers)
+  // The faces of t no other live tet has. Face f is shared when a live tet u != t around its
+  // first node holds its other two (a live tet's nodes are distinct, so the two positions of u
+  // equal to one of them are one each). Faces 1 to 3 start with t's node 0 and face 0 with its
+  // node 1: one pass over each of those two stars, with per tet the mask of t's nodes it holds.
   auto boundaryFaceCount = [&](int t) {
-    int count = 0;
+    const int t0 = mesh.T(t, 0), t1 = mesh.T(t, 1), t2 = mesh.T(t, 2), t3 = mesh.T(t, 3);
+    auto holds = [&](int u) {
+      const int w0 = mesh.T(u, 0), w1 = mesh.T(u, 1), w2 = mesh.T(u, 2), w3 = mesh.T(u, 3);
+      return unsigned(w0 == t1 || w1 == t1 || w2 == t1 || w3 == t1) << 1 |
+             unsigned(w0 == t2 || w1 == t2 || w2 == t2 || w3 == t2) << 2 |
+             unsigned(w0 == t3 || w1 == t3 || w2 == t3 || w3 == t3) << 3;
+    };
+    unsigned shared = 0;  // bit f: face f is shared
+    for (const std::int32_t *s = starB(t0), *sEnd = starE(t0); s < sEnd && shared != 0xEu; ++s) {
+      const int u = (*s);
+      if (u == t || (*dead)[u]) continue;
+      const unsigned h = holds(u);  // (bit 0 unused: u holds t's node 0)
+      for (int f = 1; f < 4; ++f) {
+        const unsigned S = 0xEu & ~(1u << f);
+        if ((h & S) == S) shared |= 1u << f;
+      }
+    }
+    for (const std::int32_t *s = starB(t1), *sEnd = starE(t1); s < sEnd; ++s) {
+      const int u = (*s);
+      if (u == t || (*dead)[u]) continue;
+      if ((holds(u) & 0xCu) == 0xCu) {
+        shared |= 1u;
+        break;
+      }
+    }
+    const int count = 4 - std::popcount(shared);
+#ifdef HYSIM_CHECK_EXACT
+    int ref = 0;
     for (int f = 0; f < 4; ++f) {
       const int a = mesh.T(t, kFace[f][0]), b = mesh.T(t, kFace[f][1]), c = mesh.T(t, kFace[f][2]);
-      bool shared = false;
-      for (const std::int32_t *s = starB(a), *sEnd = starE(a); s < sEnd && !shared; ++s) {
+      bool sh = false;
+      for (const std::int32_t *s = starB(a), *sEnd = starE(a); s < sEnd && !sh; ++s) {
         const int u = (*s);
         if (u == t || (*dead)[u]) continue;
         int hits = 0;
         for (int k = 0; k < 4; ++k) hits += mesh.T(u, k) == b || mesh.T(u, k) == c;
-        shared = hits == 2;
+        sh = hits == 2;
       }
-      count += shared ? 0 : 1;
+      ref += sh ? 0 : 1;
     }
+    if (ref != count) std::abort();
+#endif
     return count;
   };
   // The tets around v (live ones from the node->tet lists, plus `extra`).
