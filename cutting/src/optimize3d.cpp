@@ -575,7 +575,8 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
         break;
       }
     }
-    const int count = 4 - std::popcount(shared);
+    constexpr int kUnshared[16] = {4, 3, 3, 2, 3, 2, 2, 1, 3, 2, 2, 1, 2, 1, 1, 0};  // 4 - popcount
+    const int count = kUnshared[shared];
 #ifdef HYSIM_CHECK_EXACT
     int ref = 0;
     for (int f = 0; f < 4; ++f) {
@@ -872,7 +873,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     };
     failedPrev.clear();
     failedNow.clear();
-    std::vector<std::int32_t> cands, candsMerged, edgeAll;
+    std::vector<std::int32_t> cands, candsMerged;
     // The live tets around t's nodes 0, 1 and 2 (star order; t among them), each with the mask
     // c of t's nodes it contains (bit k: t's node k is one of its nodes): the face and edge
     // searches below read them instead of scanning the stars again. The scans counted the
@@ -1018,26 +1019,45 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
           }
           nearOff[3] = static_cast<int>(nearTets.size());
         }
-        // The tets around each edge (i, j) of t, i < j (from the list of node i, in its order).
-        int edgeOff[7], edgeSameMat[6];
-        edgeAll.clear();
-        for (int i = 0, e = 0; i < 4; ++i)
-          for (int j = i + 1; j < 4; ++j, ++e) {
-            edgeOff[e] = static_cast<int>(edgeAll.size());
-            const unsigned S = (1u << i) | (1u << j);
-            bool sameMat = true;
+        // The tets around each edge (i, j) of t, i < j (from the list of node i, in its order;
+        // bit j of a tet's mask around node i): their count and the first six, all that the
+        // 3-2 flip (three) and the edge removal (four to six) read. And the neighbour across
+        // each face f: the first other tet around the face's first node (node 1 for face 0,
+        // node 0 for the others) holding the face's three nodes.
+        constexpr int kEdgeOf[4][4] = {{-1, 0, 1, 2}, {0, -1, 3, 4}, {1, 3, -1, 5}, {2, 4, 5, -1}};
+        std::int32_t edgeTetsOf[6][6];
+        int edgeN[6] = {0, 0, 0, 0, 0, 0}, edgeSameMat[6] = {1, 1, 1, 1, 1, 1};
+        int faceU[4] = {-1, -1, -1, -1};
+        {
+          const int matT = mesh.material(t);
+          for (int i = 0; i < 3; ++i)
             for (int k = nearOff[i]; k < nearOff[i + 1]; ++k) {
+              const unsigned c = nearTets[k].c;
+              const std::int32_t s = nearTets[k].s;
 #ifdef HYSIM_CHECK_EXACT
-              checkHits(nearTets[k], S, 2);
+              for (int j = i + 1; j < 4; ++j) checkHits(nearTets[k], (1u << i) | (1u << j), 2);
+              for (int f = 0; f < 4; ++f)
+                if (kFace[f][0] == i) checkHits(nearTets[k], 0xFu & ~(1u << f), 3);
 #endif
-              if ((nearTets[k].c & S) == S) {
-                edgeAll.push_back(nearTets[k].s);
-                sameMat = sameMat && mesh.material(nearTets[k].s) == mesh.material(t);
+              if ((c >> (i + 1)) == 0) continue;  // (no other node of t after node i)
+              for (int j = i + 1; j < 4; ++j)
+                if (c & (1u << j)) {
+                  const int e = kEdgeOf[i][j];
+                  if (edgeN[e] < 6) edgeTetsOf[e][edgeN[e]] = s;
+                  ++edgeN[e];
+                  edgeSameMat[e] = edgeSameMat[e] && mesh.material(s) == matT;
+                }
+              if (s == t || i > 1) continue;
+              if (i == 1) {
+                if (faceU[0] < 0 && (c & 0xEu) == 0xEu) faceU[0] = s;
+              } else {
+                for (int f = 1; f < 4; ++f) {
+                  const unsigned S = 0xFu & ~(1u << f);
+                  if (faceU[f] < 0 && (c & S) == S) faceU[f] = s;
+                }
               }
             }
-            edgeSameMat[e] = sameMat;
-          }
-        edgeOff[6] = static_cast<int>(edgeAll.size());
+        }
         // 2-3.
         const bool slot = [&]() {
           while (!freeSlots.empty() && !(*dead)[freeSlots.back()]) freeSlots.pop_back();
@@ -1046,17 +1066,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
         for (int f = 0; f < 4 && slot; ++f) {
           const int a = mesh.T(t, kFace[f][0]), b = mesh.T(t, kFace[f][1]), c = mesh.T(t, kFace[f][2]),
                     d = mesh.T(t, f);
-          int u = -1;
-          {
-            const int li = kFace[f][0];  // a = t's node li
-            const unsigned S = (1u << kFace[f][0]) | (1u << kFace[f][1]) | (1u << kFace[f][2]);
-            for (int k = nearOff[li]; k < nearOff[li + 1] && u < 0; ++k) {
-#ifdef HYSIM_CHECK_EXACT
-              checkHits(nearTets[k], S, 3);
-#endif
-              if (nearTets[k].s != t && (nearTets[k].c & S) == S) u = nearTets[k].s;
-            }
-          }
+          const int u = faceU[f];
           if (u < 0 || mesh.material(u) != mesh.material(t)) continue;
           int e = -1;
           for (int k = 0; k < 4; ++k)
@@ -1099,8 +1109,8 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
         for (int i = 0, ei = 0; i < 4; ++i)
           for (int j = i + 1; j < 4; ++j, ++ei) {
             const int a = mesh.T(t, i), b = mesh.T(t, j);
-            const std::int32_t* edgeTets = edgeAll.data() + edgeOff[ei];
-            if (edgeOff[ei + 1] - edgeOff[ei] != 3) continue;
+            const std::int32_t* edgeTets = edgeTetsOf[ei];
+            if (edgeN[ei] != 3) continue;
             if (!edgeSameMat[ei]) continue;
             // The other two nodes of each tet; a closed ring uses each of three nodes twice.
             std::int32_t others[6], m = 0;
@@ -1155,9 +1165,9 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
           for (int i = 0, ei = 0; i < 4; ++i)
             for (int j = i + 1; j < 4; ++j, ++ei) {
               const int a = mesh.T(t, i), b = mesh.T(t, j);
-              const std::int32_t* edgeTets = edgeAll.data() + edgeOff[ei];
+              const std::int32_t* edgeTets = edgeTetsOf[ei];
               const bool sameMat = edgeSameMat[ei] != 0;
-              const int n = edgeOff[ei + 1] - edgeOff[ei];
+              const int n = edgeN[ei];
               if (n > 4 && n <= 6 && avail < 0) avail = availSlots();
               if (n < 4 || n > 6 || (n > 4 && n - 4 > avail) || !sameMat) continue;
               // The ring: each tet's other two nodes, chained into one cycle.
