@@ -855,6 +855,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   };
   std::vector<FlipFailed> failedPrev, failedNow;
   std::vector<std::int32_t> flipMark, flipRebuilt, flipChanged, flipSeeds;
+  std::vector<std::uint8_t> flipNodeBit;  // per node: bit k when it is node k of the tet tried (else 0)
   std::int32_t flipClock = 0;
   auto flips = [&]() {
     if (!curved || !(options.flip_quality > 0)) return;
@@ -863,11 +864,13 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     freeSlots.erase(std::unique(freeSlots.begin(), freeSlots.end()), freeSlots.end());
     // The dead tets in freeSlots (the slots free for reuse), counted when first needed after
     // each change.
+    // Only min(count, 2) is read (the checks of failed candidates; an edge removal takes at most
+    // two): the count stops at 2.
     int availNow = -1;
     auto availSlots = [&]() {
       if (availNow < 0) {
         availNow = 0;
-        for (int fs : freeSlots) availNow += (*dead)[fs] ? 1 : 0;
+        for (size_t k = 0; k < freeSlots.size() && availNow < 2; ++k) availNow += (*dead)[freeSlots[k]] ? 1 : 0;
       }
       return availNow;
     };
@@ -984,26 +987,20 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
         nearTets.clear();
         {
           const int t0 = mesh.T(t, 0), t1 = mesh.T(t, 1), t2 = mesh.T(t, 2), t3 = mesh.T(t, 3);
-#if defined(__SSE2__)
-          // (Bit l of lane k: node l of the tet equals t's node k, four compares at once.)
-          const __m128i tNodes = _mm_set_epi32(t3, t2, t1, t0);
-#endif
+          // A tet's mask: the OR of its nodes' bits (t's nodes carry bits 0 to 3 while it is
+          // tried; every other node 0).
+          if (flipNodeBit.empty()) flipNodeBit.assign(N, 0);
+          std::uint8_t* const nodeBit = flipNodeBit.data();
+          nodeBit[t0] = 1;
+          nodeBit[t1] = 2;
+          nodeBit[t2] = 4;
+          nodeBit[t3] = 8;
           for (int i = 0; i < 3; ++i) {
             nearOff[i] = static_cast<int>(nearTets.size());
             for (const std::int32_t *s = starB(mesh.T(t, i)), *sEnd = starE(mesh.T(t, i)); s < sEnd; ++s) {
               if ((*dead)[*s]) continue;
               const int w0 = mesh.T(*s, 0), w1 = mesh.T(*s, 1), w2 = mesh.T(*s, 2), w3 = mesh.T(*s, 3);
-#if defined(__SSE2__)
-              const __m128i eq = _mm_or_si128(
-                  _mm_or_si128(_mm_cmpeq_epi32(_mm_set1_epi32(w0), tNodes), _mm_cmpeq_epi32(_mm_set1_epi32(w1), tNodes)),
-                  _mm_or_si128(_mm_cmpeq_epi32(_mm_set1_epi32(w2), tNodes), _mm_cmpeq_epi32(_mm_set1_epi32(w3), tNodes)));
-              const unsigned c = static_cast<unsigned>(_mm_movemask_ps(_mm_castsi128_ps(eq)));
-#else
-              const unsigned c = unsigned(w0 == t0 || w1 == t0 || w2 == t0 || w3 == t0) |
-                                 unsigned(w0 == t1 || w1 == t1 || w2 == t1 || w3 == t1) << 1 |
-                                 unsigned(w0 == t2 || w1 == t2 || w2 == t2 || w3 == t2) << 2 |
-                                 unsigned(w0 == t3 || w1 == t3 || w2 == t3 || w3 == t3) << 3;
-#endif
+              const unsigned c = unsigned(nodeBit[w0] | nodeBit[w1] | nodeBit[w2] | nodeBit[w3]);
 #ifdef HYSIM_CHECK_EXACT
               unsigned m = 0;
               const int wl[4] = {w0, w1, w2, w3};
@@ -1011,12 +1008,14 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
                 m |= (unsigned(wl[l] == t0) | unsigned(wl[l] == t1) << 1 | unsigned(wl[l] == t2) << 2 |
                       unsigned(wl[l] == t3) << 3)
                      << (4 * l);
+              if (c != ((m | m >> 4 | m >> 8 | m >> 12) & 0xFu)) std::abort();
               nearTets.push_back({*s, c, m});
 #else
               nearTets.push_back({*s, c});
 #endif
             }
           }
+          nodeBit[t0] = nodeBit[t1] = nodeBit[t2] = nodeBit[t3] = 0;
           nearOff[3] = static_cast<int>(nearTets.size());
         }
         // The tets around each edge (i, j) of t, i < j (from the list of node i, in its order;
