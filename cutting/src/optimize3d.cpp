@@ -545,20 +545,54 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   // the mesh stays manifold: the boundary faces around each of its nodes still form one
   // closed loop (a disc), or the node had no other tet (it goes with the sliver). Its volume (tiny: it is flat) is lost.
   std::vector<std::int32_t> link;  // scratch: link edges of a node, as pairs (discAround's local numbers)
+  // The faces of t no other live tet has. Face f is shared when a live tet u != t around its
+  // first node holds its other two (a live tet's nodes are distinct, so the two positions of u
+  // equal to one of them are one each). Faces 1 to 3 start with t's node 0 and face 0 with its
+  // node 1: one pass over each of those two stars, with per tet the mask of t's nodes it holds.
   auto boundaryFaceCount = [&](int t) {
-    int count = 0;
+    const int t0 = mesh.T(t, 0), t1 = mesh.T(t, 1), t2 = mesh.T(t, 2), t3 = mesh.T(t, 3);
+    auto holds = [&](int u) {
+      const int w0 = mesh.T(u, 0), w1 = mesh.T(u, 1), w2 = mesh.T(u, 2), w3 = mesh.T(u, 3);
+      return unsigned(w0 == t1 || w1 == t1 || w2 == t1 || w3 == t1) << 1 |
+             unsigned(w0 == t2 || w1 == t2 || w2 == t2 || w3 == t2) << 2 |
+             unsigned(w0 == t3 || w1 == t3 || w2 == t3 || w3 == t3) << 3;
+    };
+    unsigned shared = 0;  // bit f: face f is shared
+    for (const std::int32_t *s = starB(t0), *sEnd = starE(t0); s < sEnd && shared != 0xEu; ++s) {
+      const int u = (*s);
+      if (u == t || (*dead)[u]) continue;
+      const unsigned h = holds(u);  // (bit 0 unused: u holds t's node 0)
+      for (int f = 1; f < 4; ++f) {
+        const unsigned S = 0xEu & ~(1u << f);
+        if ((h & S) == S) shared |= 1u << f;
+      }
+    }
+    for (const std::int32_t *s = starB(t1), *sEnd = starE(t1); s < sEnd; ++s) {
+      const int u = (*s);
+      if (u == t || (*dead)[u]) continue;
+      if ((holds(u) & 0xCu) == 0xCu) {
+        shared |= 1u;
+        break;
+      }
+    }
+    constexpr int kUnshared[16] = {4, 3, 3, 2, 3, 2, 2, 1, 3, 2, 2, 1, 2, 1, 1, 0};  // 4 - popcount
+    const int count = kUnshared[shared];
+#ifdef HYSIM_CHECK_EXACT
+    int ref = 0;
     for (int f = 0; f < 4; ++f) {
       const int a = mesh.T(t, kFace[f][0]), b = mesh.T(t, kFace[f][1]), c = mesh.T(t, kFace[f][2]);
-      bool shared = false;
-      for (const std::int32_t *s = starB(a), *sEnd = starE(a); s < sEnd && !shared; ++s) {
+      bool sh = false;
+      for (const std::int32_t *s = starB(a), *sEnd = starE(a); s < sEnd && !sh; ++s) {
         const int u = (*s);
         if (u == t || (*dead)[u]) continue;
         int hits = 0;
         for (int k = 0; k < 4; ++k) hits += mesh.T(u, k) == b || mesh.T(u, k) == c;
-        shared = hits == 2;
+        sh = hits == 2;
       }
-      count += shared ? 0 : 1;
+      ref += sh ? 0 : 1;
     }
+    if (ref != count) std::abort();
+#endif
     return count;
   };
   // The tets around v (live ones from the node->tet lists, plus `extra`).
@@ -821,6 +855,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   };
   std::vector<FlipFailed> failedPrev, failedNow;
   std::vector<std::int32_t> flipMark, flipRebuilt, flipChanged, flipSeeds;
+  std::vector<std::uint8_t> flipNodeBit;  // per node: bit k when it is node k of the tet tried (else 0)
   std::int32_t flipClock = 0;
   auto flips = [&]() {
     if (!curved || !(options.flip_quality > 0)) return;
@@ -829,29 +864,43 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     freeSlots.erase(std::unique(freeSlots.begin(), freeSlots.end()), freeSlots.end());
     // The dead tets in freeSlots (the slots free for reuse), counted when first needed after
     // each change.
+    // Only min(count, 2) is read (the checks of failed candidates; an edge removal takes at most
+    // two): the count stops at 2.
     int availNow = -1;
     auto availSlots = [&]() {
       if (availNow < 0) {
         availNow = 0;
-        for (int fs : freeSlots) availNow += (*dead)[fs] ? 1 : 0;
+        for (size_t k = 0; k < freeSlots.size() && availNow < 2; ++k) availNow += (*dead)[freeSlots[k]] ? 1 : 0;
       }
       return availNow;
     };
     failedPrev.clear();
     failedNow.clear();
-    std::vector<std::int32_t> cands, candsMerged, edgeAll;
-    // The live tets around t's nodes 0, 1 and 2 (star order; t among them), each with, per
-    // position l (4 bits each), the mask of t's nodes equal to its node l: the face and edge
-    // searches below read them instead of scanning the stars again. hitsOf(m, S): how many
-    // positions hold one of t's nodes in S (the count the scans took).
+    std::vector<std::int32_t> cands, candsMerged;
+    // The live tets around t's nodes 0, 1 and 2 (star order; t among them), each with the mask
+    // c of t's nodes it contains (bit k: t's node k is one of its nodes): the face and edge
+    // searches below read them instead of scanning the stars again. The scans counted the
+    // positions l of the tet whose node is one of t's nodes in S (hitsOf below, with m holding
+    // per position l, 4 bits each, the mask of t's nodes equal to node l). A live tet's four
+    // nodes are distinct and so are t's: each nibble of m has at most one bit and different
+    // nibbles have different bits, so that count is popcount(c & S) with c the OR of the
+    // nibbles; "count == |S|" is then (c & S) == S (checked under HYSIM_CHECK_EXACT).
     struct NearTet {
       std::int32_t s;
-      std::uint16_t m;
+      std::uint32_t c;
+#ifdef HYSIM_CHECK_EXACT
+      std::uint32_t m;
+#endif
     };
     std::vector<NearTet> nearTets;
+#ifdef HYSIM_CHECK_EXACT
     auto hitsOf = [](unsigned m, unsigned S) {
       return int((m & S) != 0) + int(((m >> 4) & S) != 0) + int(((m >> 8) & S) != 0) + int(((m >> 12) & S) != 0);
     };
+    auto checkHits = [&](const NearTet& nt, unsigned S, int need) {
+      if ((hitsOf(nt.m, S) == need) != ((nt.c & S) == S)) std::abort();
+    };
+#endif
     auto vol6 = [&](int a, int b, int c, int d) {
       const Vec3 p0 = pos(a);
       return (pos(b) - p0).dot((pos(c) - p0).cross(pos(d) - p0));
@@ -938,46 +987,76 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
         nearTets.clear();
         {
           const int t0 = mesh.T(t, 0), t1 = mesh.T(t, 1), t2 = mesh.T(t, 2), t3 = mesh.T(t, 3);
-#if defined(__SSE2__)
-          // (Bit l of lane k: node l of the tet equals t's node k, four compares at once.)
-          const __m128i tNodes = _mm_set_epi32(t3, t2, t1, t0);
-#endif
+          // A tet's mask: the OR of its nodes' bits (t's nodes carry bits 0 to 3 while it is
+          // tried; every other node 0).
+          if (flipNodeBit.empty()) flipNodeBit.assign(N, 0);
+          std::uint8_t* const nodeBit = flipNodeBit.data();
+          nodeBit[t0] = 1;
+          nodeBit[t1] = 2;
+          nodeBit[t2] = 4;
+          nodeBit[t3] = 8;
           for (int i = 0; i < 3; ++i) {
             nearOff[i] = static_cast<int>(nearTets.size());
             for (const std::int32_t *s = starB(mesh.T(t, i)), *sEnd = starE(mesh.T(t, i)); s < sEnd; ++s) {
               if ((*dead)[*s]) continue;
+              const int w0 = mesh.T(*s, 0), w1 = mesh.T(*s, 1), w2 = mesh.T(*s, 2), w3 = mesh.T(*s, 3);
+              const unsigned c = unsigned(nodeBit[w0] | nodeBit[w1] | nodeBit[w2] | nodeBit[w3]);
+#ifdef HYSIM_CHECK_EXACT
               unsigned m = 0;
-              for (int l = 0; l < 4; ++l) {
-                const int w = mesh.T(*s, l);
-#if defined(__SSE2__)
-                const unsigned eq = static_cast<unsigned>(
-                    _mm_movemask_ps(_mm_castsi128_ps(_mm_cmpeq_epi32(_mm_set1_epi32(w), tNodes))));
-                m |= eq << (4 * l);
+              const int wl[4] = {w0, w1, w2, w3};
+              for (int l = 0; l < 4; ++l)
+                m |= (unsigned(wl[l] == t0) | unsigned(wl[l] == t1) << 1 | unsigned(wl[l] == t2) << 2 |
+                      unsigned(wl[l] == t3) << 3)
+                     << (4 * l);
+              if (c != ((m | m >> 4 | m >> 8 | m >> 12) & 0xFu)) std::abort();
+              nearTets.push_back({*s, c, m});
 #else
-                m |= (unsigned(w == t0) | unsigned(w == t1) << 1 | unsigned(w == t2) << 2 | unsigned(w == t3) << 3) << (4 * l);
+              nearTets.push_back({*s, c});
 #endif
-              }
-              nearTets.push_back({*s, static_cast<std::uint16_t>(m)});
             }
           }
+          nodeBit[t0] = nodeBit[t1] = nodeBit[t2] = nodeBit[t3] = 0;
           nearOff[3] = static_cast<int>(nearTets.size());
         }
-        // The tets around each edge (i, j) of t, i < j (from the list of node i, in its order).
-        int edgeOff[7], edgeSameMat[6];
-        edgeAll.clear();
-        for (int i = 0, e = 0; i < 4; ++i)
-          for (int j = i + 1; j < 4; ++j, ++e) {
-            edgeOff[e] = static_cast<int>(edgeAll.size());
-            const unsigned S = (1u << i) | (1u << j);
-            bool sameMat = true;
-            for (int k = nearOff[i]; k < nearOff[i + 1]; ++k)
-              if (hitsOf(nearTets[k].m, S) == 2) {
-                edgeAll.push_back(nearTets[k].s);
-                sameMat = sameMat && mesh.material(nearTets[k].s) == mesh.material(t);
+        // The tets around each edge (i, j) of t, i < j (from the list of node i, in its order;
+        // bit j of a tet's mask around node i): their count and the first six, all that the
+        // 3-2 flip (three) and the edge removal (four to six) read. And the neighbour across
+        // each face f: the first other tet around the face's first node (node 1 for face 0,
+        // node 0 for the others) holding the face's three nodes.
+        constexpr int kEdgeOf[4][4] = {{-1, 0, 1, 2}, {0, -1, 3, 4}, {1, 3, -1, 5}, {2, 4, 5, -1}};
+        std::int32_t edgeTetsOf[6][6];
+        int edgeN[6] = {0, 0, 0, 0, 0, 0}, edgeSameMat[6] = {1, 1, 1, 1, 1, 1};
+        int faceU[4] = {-1, -1, -1, -1};
+        {
+          const int matT = mesh.material(t);
+          for (int i = 0; i < 3; ++i)
+            for (int k = nearOff[i]; k < nearOff[i + 1]; ++k) {
+              const unsigned c = nearTets[k].c;
+              const std::int32_t s = nearTets[k].s;
+#ifdef HYSIM_CHECK_EXACT
+              for (int j = i + 1; j < 4; ++j) checkHits(nearTets[k], (1u << i) | (1u << j), 2);
+              for (int f = 0; f < 4; ++f)
+                if (kFace[f][0] == i) checkHits(nearTets[k], 0xFu & ~(1u << f), 3);
+#endif
+              if ((c >> (i + 1)) == 0) continue;  // (no other node of t after node i)
+              for (int j = i + 1; j < 4; ++j)
+                if (c & (1u << j)) {
+                  const int e = kEdgeOf[i][j];
+                  if (edgeN[e] < 6) edgeTetsOf[e][edgeN[e]] = s;
+                  ++edgeN[e];
+                  edgeSameMat[e] = edgeSameMat[e] && mesh.material(s) == matT;
+                }
+              if (s == t || i > 1) continue;
+              if (i == 1) {
+                if (faceU[0] < 0 && (c & 0xEu) == 0xEu) faceU[0] = s;
+              } else {
+                for (int f = 1; f < 4; ++f) {
+                  const unsigned S = 0xFu & ~(1u << f);
+                  if (faceU[f] < 0 && (c & S) == S) faceU[f] = s;
+                }
               }
-            edgeSameMat[e] = sameMat;
-          }
-        edgeOff[6] = static_cast<int>(edgeAll.size());
+            }
+        }
         // 2-3.
         const bool slot = [&]() {
           while (!freeSlots.empty() && !(*dead)[freeSlots.back()]) freeSlots.pop_back();
@@ -986,13 +1065,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
         for (int f = 0; f < 4 && slot; ++f) {
           const int a = mesh.T(t, kFace[f][0]), b = mesh.T(t, kFace[f][1]), c = mesh.T(t, kFace[f][2]),
                     d = mesh.T(t, f);
-          int u = -1;
-          {
-            const int li = kFace[f][0];  // a = t's node li
-            const unsigned S = (1u << kFace[f][0]) | (1u << kFace[f][1]) | (1u << kFace[f][2]);
-            for (int k = nearOff[li]; k < nearOff[li + 1] && u < 0; ++k)
-              if (nearTets[k].s != t && hitsOf(nearTets[k].m, S) == 3) u = nearTets[k].s;
-          }
+          const int u = faceU[f];
           if (u < 0 || mesh.material(u) != mesh.material(t)) continue;
           int e = -1;
           for (int k = 0; k < 4; ++k)
@@ -1035,8 +1108,8 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
         for (int i = 0, ei = 0; i < 4; ++i)
           for (int j = i + 1; j < 4; ++j, ++ei) {
             const int a = mesh.T(t, i), b = mesh.T(t, j);
-            const std::int32_t* edgeTets = edgeAll.data() + edgeOff[ei];
-            if (edgeOff[ei + 1] - edgeOff[ei] != 3) continue;
+            const std::int32_t* edgeTets = edgeTetsOf[ei];
+            if (edgeN[ei] != 3) continue;
             if (!edgeSameMat[ei]) continue;
             // The other two nodes of each tet; a closed ring uses each of three nodes twice.
             std::int32_t others[6], m = 0;
@@ -1091,9 +1164,9 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
           for (int i = 0, ei = 0; i < 4; ++i)
             for (int j = i + 1; j < 4; ++j, ++ei) {
               const int a = mesh.T(t, i), b = mesh.T(t, j);
-              const std::int32_t* edgeTets = edgeAll.data() + edgeOff[ei];
+              const std::int32_t* edgeTets = edgeTetsOf[ei];
               const bool sameMat = edgeSameMat[ei] != 0;
-              const int n = edgeOff[ei + 1] - edgeOff[ei];
+              const int n = edgeN[ei];
               if (n > 4 && n <= 6 && avail < 0) avail = availSlots();
               if (n < 4 || n > 6 || (n > 4 && n - 4 > avail) || !sameMat) continue;
               // The ring: each tet's other two nodes, chained into one cycle.
