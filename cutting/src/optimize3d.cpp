@@ -2004,6 +2004,13 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   std::vector<std::uint8_t> didMove(N, 0);
   std::vector<std::int32_t> movedNow;
   std::vector<double> starVolume;  // per node in the move loop, filled when first needed
+  struct StarVolTet {  // per live star tet in the move loop's volume check (see there)
+    double p[3][4];    // the corners' x, y, z
+    double a[3], b[3], e[3], nrm[3];  // p1 - p0, p2 - p0, p3 - p0, b x e (where kn != 0)
+    double old;        // its volume where n is
+    int kn;            // n's corner
+  };
+  std::vector<StarVolTet> starVol;
   int it = 0;
   bfStart.assign(N, -1);  // constraintOf keeps the boundary faces per node (see there)
   bfLen.assign(N, 0);
@@ -2140,39 +2147,77 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
           // Moves on a curved surface change the volume a little (the faces are chords): within the budget.
           double dv = 0;
           if (curved && (c.kind == Freedom::Surface || c.kind == Freedom::Fan || c.kind == Freedom::Ridge)) {
-            if (starVolume.empty())  // the star's volumes where n is (the same for every candidate)
-              for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s)
+            if (starVolume.empty()) {  // the star's volumes where n is (the same for every candidate)
+              // With them, per live star tet the parts of its volume expression that do not
+              // depend on n's position (the corners, the differences and the cross product of
+              // the fixed corners: the same operations on the same values as below).
+              const double* cx = mesh.X.col(0).data();
+              const double* cy = mesh.X.col(1).data();
+              const double* cz = mesh.X.col(2).data();
+              starVol.clear();
+              for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s) {
                 starVolume.push_back((*dead)[*s] ? 0.0 : tetVolumeHere(mesh, *s));
+                if ((*dead)[*s]) continue;
+                StarVolTet sv;
+                double px[4], py[4], pz[4];
+                sv.kn = -1;
+                for (int k = 0; k < 4; ++k) {
+                  const int v = mesh.T(*s, k);
+                  if (v == n && sv.kn < 0) sv.kn = k;
+                  px[k] = cx[v];
+                  py[k] = cy[v];
+                  pz[k] = cz[v];
+                }
+                sv.old = starVolume.back();
+                for (int k = 0; k < 4; ++k) {
+                  sv.p[0][k] = px[k];
+                  sv.p[1][k] = py[k];
+                  sv.p[2][k] = pz[k];
+                }
+                if (sv.kn != 0) {
+                  sv.a[0] = px[1] - px[0], sv.a[1] = py[1] - py[0], sv.a[2] = pz[1] - pz[0];
+                  sv.b[0] = px[2] - px[0], sv.b[1] = py[2] - py[0], sv.b[2] = pz[2] - pz[0];
+                  sv.e[0] = px[3] - px[0], sv.e[1] = py[3] - py[0], sv.e[2] = pz[3] - pz[0];
+                  const double bx = sv.b[0], by = sv.b[1], bz = sv.b[2];
+                  const double ex = sv.e[0], ey = sv.e[1], ez = sv.e[2];
+                  sv.nrm[0] = by * ez - bz * ey, sv.nrm[1] = bz * ex - bx * ez, sv.nrm[2] = bx * ey - by * ex;
+                }
+                starVol.push_back(sv);
+              }
+            }
             // (The volume of each tet with n at y in scalars, as tetVolumeHere: the same value
             // as the vector expression (p1 - p0).dot((p2 - p0).cross(p3 - p0)).)
-            const double* oldVolume = starVolume.data();
-            const double* cx = mesh.X.col(0).data();
-            const double* cy = mesh.X.col(1).data();
-            const double* cz = mesh.X.col(2).data();
-            for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s, ++oldVolume) {
-              if ((*dead)[*s]) continue;
-              double px[4], py[4], pz[4];
-              for (int k = 0; k < 4; ++k) {
-                const int v = mesh.T(*s, k);
-                const bool here = v == n;
-                px[k] = here ? y[0] : cx[v];
-                py[k] = here ? y[1] : cy[v];
-                pz[k] = here ? y[2] : cz[v];
+            for (const StarVolTet& sv : starVol) {
+              double ax, ay, az, bx, by, bz, ex, ey, ez, vol6;
+              if (sv.kn == 0) {
+                ax = sv.p[0][1] - y[0], ay = sv.p[1][1] - y[1], az = sv.p[2][1] - y[2];
+                bx = sv.p[0][2] - y[0], by = sv.p[1][2] - y[1], bz = sv.p[2][2] - y[2];
+                ex = sv.p[0][3] - y[0], ey = sv.p[1][3] - y[1], ez = sv.p[2][3] - y[2];
+              } else {
+                ax = sv.a[0], ay = sv.a[1], az = sv.a[2];
+                bx = sv.b[0], by = sv.b[1], bz = sv.b[2];
+                ex = sv.e[0], ey = sv.e[1], ez = sv.e[2];
+                const double dx = y[0] - sv.p[0][0], dy = y[1] - sv.p[1][0], dz = y[2] - sv.p[2][0];
+                if (sv.kn == 1) ax = dx, ay = dy, az = dz;
+                else if (sv.kn == 2) bx = dx, by = dy, bz = dz;
+                else if (sv.kn == 3) ex = dx, ey = dy, ez = dz;
               }
-              const double ax = px[1] - px[0], ay = py[1] - py[0], az = pz[1] - pz[0];
-              const double bx = px[2] - px[0], by = py[2] - py[0], bz = pz[2] - pz[0];
-              const double ex = px[3] - px[0], ey = py[3] - py[0], ez = pz[3] - pz[0];
-              const double nx = by * ez - bz * ey, ny = bz * ex - bx * ez, nz = bx * ey - by * ex;
-              const double vol6 = (ax * nx + ay * ny) + az * nz;
+              if (sv.kn == 1 || sv.kn < 0) {  // (kn < 0: n not a corner, not expected)
+                vol6 = (ax * sv.nrm[0] + ay * sv.nrm[1]) + az * sv.nrm[2];
+              } else {
+                const double nx = by * ez - bz * ey, ny = bz * ex - bx * ez, nz = bx * ey - by * ex;
+                vol6 = (ax * nx + ay * ny) + az * nz;
+              }
 #ifdef HYSIM_CHECK_EXACT
               {
                 Vec3 p[4];
-                for (int k = 0; k < 4; ++k) p[k] = mesh.T(*s, k) == n ? y : pos(mesh.T(*s, k));
+                for (int k = 0; k < 4; ++k)
+                  p[k] = k == sv.kn ? y : Vec3(sv.p[0][k], sv.p[1][k], sv.p[2][k]);
                 const double ref = (p[1] - p[0]).dot((p[2] - p[0]).cross(p[3] - p[0]));
                 if (std::memcmp(&ref, &vol6, sizeof vol6) != 0) std::abort();
               }
 #endif
-              dv += vol6 / 6.0 - *oldVolume;
+              dv += vol6 / 6.0 - sv.old;
             }
             if (!moveBudget.fits(dv) || std::abs(dv) > options.move_volume_fraction * edgeTet) continue;
           }
