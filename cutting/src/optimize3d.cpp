@@ -278,6 +278,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     std::int32_t v[4];
     std::uint32_t ver[4];
     double q;
+    std::int8_t up;  // tetVolume6Here > 0 at these positions (1, 0), -1: not asked yet
   };
   std::vector<std::int32_t> qSlot(M, -1);
   std::vector<QEntry> qPool;
@@ -296,6 +297,33 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       qPool.emplace_back();
     }
     cur.q = radiusRatio(pos(cur.v[0]), pos(cur.v[1]), pos(cur.v[2]), pos(cur.v[3]));
+    cur.up = -1;
+    qPool[slot] = cur;
+    return cur.q;
+  };
+  // vol6 > 0 ? tetQ(t) : -1 (vol6 = tetVolume6Here(mesh, t)), the sign cached with q*.
+  // (An entry is only made where vol6 > 0, as tetQ is only asked there.)
+  auto tetQUp = [&](int t) {
+    QEntry cur;
+    for (int k = 0; k < 4; ++k) {
+      cur.v[k] = mesh.T(t, k);
+      cur.ver[k] = nodeVer[cur.v[k]];
+    }
+    std::int32_t& slot = qSlot[t];
+    if (slot >= 0) {
+      QEntry& e = qPool[slot];
+      if (std::equal(cur.v, cur.v + 4, e.v) && std::equal(cur.ver, cur.ver + 4, e.ver)) {
+        if (e.up < 0) e.up = tetVolume6Here(mesh, t) > 0 ? 1 : 0;
+        return e.up ? e.q : -1.0;
+      }
+    }
+    if (!(tetVolume6Here(mesh, t) > 0)) return -1.0;
+    if (slot < 0) {
+      slot = static_cast<std::int32_t>(qPool.size());
+      qPool.emplace_back();
+    }
+    cur.q = radiusRatio(pos(cur.v[0]), pos(cur.v[1]), pos(cur.v[2]), pos(cur.v[3]));
+    cur.up = 1;
     qPool[slot] = cur;
     return cur.q;
   };
@@ -311,8 +339,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s) {
       const int t = (*s);
       if ((*dead)[t]) continue;
-      const double vol6 = tetVolume6Here(mesh, t);  // (p1 - p0).dot((p2 - p0).cross(p3 - p0))
-      const double qt = vol6 > 0 ? tetQ(t) : -1.0;
+      const double qt = tetQUp(t);  // -1 where not (p1 - p0).dot((p2 - p0).cross(p3 - p0)) > 0
       if (qt < q) {
         q = qt;
         if (worstTet) *worstTet = (*s);
