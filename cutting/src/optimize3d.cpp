@@ -2085,13 +2085,26 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
           const double len = d.norm();
           if (len > 0) force += (len - h) * d / len;
         }
+      // The worst tet's corners, n's at wtK (for tetQAt(wt, n, y) below: the same values).
+      Vec3 wtP[4];
+      int wtK = -1;
+      for (int k = 0; k < 4; ++k) {
+        const int v = mesh.T(wt, k);
+        wtP[k] = pos(v);
+        if (v == n) wtK = k;
+      }
+      auto wtQAt = [&](const Vec3& y) {
+        Vec3 p[4] = {wtP[0], wtP[1], wtP[2], wtP[3]};
+        p[wtK] = y;
+        return radiusRatioOriented(p[0], p[1], p[2], p[3]);
+      };
       // Gradient of the worst element's q* (central differences).
       Vec3 grad = Vec3::Zero();
       const double fd = 1e-4 * h;
       for (int a = 0; a < 3; ++a) {
         Vec3 e = Vec3::Zero();
         e[a] = fd;
-        grad[a] = (tetQAt(wt, n, x + e) - tetQAt(wt, n, x - e)) / (2 * fd);
+        grad[a] = (wtQAt(x + e) - wtQAt(x - e)) / (2 * fd);
       }
       grad = unitIn(grad);
       // Push: away from the face opposite n in its worst tet.
@@ -2169,7 +2182,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
           // caches and starAbove's lastBelow only skip or order work), so any order gives the
           // same moves: the cheapest first (the worst tet, which starAbove tries first anyway),
           // then the volume check (it fails often), the surface queries after it.
-          const double qFirst = tetQAt(wt, n, y);
+          const double qFirst = wtQAt(y);
           if (!(qFirst > best)) continue;
           // Moves on a curved surface change the volume a little (the faces are chords): within the budget.
           double dv = 0;
