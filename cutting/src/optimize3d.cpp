@@ -2067,24 +2067,28 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       double sum = 0;
       int deg = 0;
       Vec3 force = Vec3::Zero();
-      for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s)
-        for (int k = 0; k < 4 && !(*dead)[(*s)]; ++k) {
+      for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s) {
+        if ((*dead)[(*s)]) continue;
+        for (int k = 0; k < 4; ++k) {
           const int m = mesh.T((*s), k);
           if (m == n) continue;
           sum += (pos(m) - x).norm();
           ++deg;
         }
+      }
       if (deg == 0) continue;
       const double h = sum / deg;
       scale = std::max(scale, h);
-      for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s)
-        for (int k = 0; k < 4 && !(*dead)[(*s)]; ++k) {
+      for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s) {
+        if ((*dead)[(*s)]) continue;
+        for (int k = 0; k < 4; ++k) {
           const int m = mesh.T((*s), k);
           if (m == n) continue;
           const Vec3 d = pos(m) - x;
           const double len = d.norm();
           if (len > 0) force += (len - h) * d / len;
         }
+      }
       // The worst tet's corners, n's at wtK (for tetQAt(wt, n, y) below: the same values).
       Vec3 wtP[4];
       int wtK = -1;
