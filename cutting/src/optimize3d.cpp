@@ -2098,9 +2098,13 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
         if (v == n) wtK = k;
       }
       auto wtQAt = [&](const Vec3& y) {
-        Vec3 p[4] = {wtP[0], wtP[1], wtP[2], wtP[3]};
-        p[wtK] = y;
-        return radiusRatioOriented(p[0], p[1], p[2], p[3]);
+        switch (wtK) {
+          case 0: return radiusRatioOriented(y, wtP[1], wtP[2], wtP[3]);
+          case 1: return radiusRatioOriented(wtP[0], y, wtP[2], wtP[3]);
+          case 2: return radiusRatioOriented(wtP[0], wtP[1], y, wtP[3]);
+          case 3: return radiusRatioOriented(wtP[0], wtP[1], wtP[2], y);
+          default: return radiusRatioOriented(wtP[0], wtP[1], wtP[2], wtP[3]);  // (n not a corner: not expected)
+        }
       };
       // Gradient of the worst element's q* (central differences).
       Vec3 grad = Vec3::Zero();
