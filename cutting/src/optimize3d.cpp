@@ -328,10 +328,14 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     return cur.q;
   };
   // Quality of tet t with node n placed at y; negative when it would invert or go flat.
-  auto tetQAt = [&](int t, int n, const Vec3& y) {
-    Vec3 p[4];
-    for (int k = 0; k < 4; ++k) p[k] = mesh.T(t, k) == n ? y : pos(mesh.T(t, k));
-    return radiusRatioOriented(p[0], p[1], p[2], p[3]);  // -1 where not (p1-p0).((p2-p0)x(p3-p0)) > 0
+  // (The corners passed directly, n's replaced by y: the same values as a copy.)
+  auto tetQAt = [&](int t, int n, const Vec3& y) {  // -1 where not (p1-p0).((p2-p0)x(p3-p0)) > 0
+    const int a = mesh.T(t, 0), b = mesh.T(t, 1), c = mesh.T(t, 2), d = mesh.T(t, 3);
+    if (a == n) return radiusRatioOriented(y, pos(b), pos(c), pos(d));
+    if (b == n) return radiusRatioOriented(pos(a), y, pos(c), pos(d));
+    if (c == n) return radiusRatioOriented(pos(a), pos(b), y, pos(d));
+    if (d == n) return radiusRatioOriented(pos(a), pos(b), pos(c), y);
+    return radiusRatioOriented(pos(a), pos(b), pos(c), pos(d));
   };
   // Worst q* around n where it is (tetQAt at its own position, through the cache).
   auto starWorst = [&](int n, int* worstTet) {
