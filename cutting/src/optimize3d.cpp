@@ -1402,8 +1402,10 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     // Sorted by length (then ends); an edge comes once per poor tet around it: one candidate
     // per (u, v), short if any of its copies is (a short edge's test accepts what the other
     // accepts, and copies would be tried one after the other on the same mesh).
-    auto byKey = [](const Cand& p, const Cand& q) {
-      return p.len != q.len ? p.len < q.len : p.u != q.u ? p.u < q.u : p.v < q.v;
+    auto byKey = [](const Cand& p, const Cand& q) {  // (the lengths are finite)
+      if (p.len < q.len) return true;
+      if (q.len < p.len) return false;
+      return p.u != q.u ? p.u < q.u : p.v < q.v;
     };
     // (c sorted by byKey: copies of a candidate are neighbours, in any order; the first
     // copy's fields are kept, the same for every copy but the tet, which the loop below does
