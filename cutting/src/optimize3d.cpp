@@ -278,6 +278,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     std::int32_t v[4];
     std::uint32_t ver[4];
     double q;
+    std::int8_t up;  // tetVolume6Here > 0 at these positions (1, 0), -1: not asked yet
   };
   std::vector<std::int32_t> qSlot(M, -1);
   std::vector<QEntry> qPool;
@@ -296,14 +297,45 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       qPool.emplace_back();
     }
     cur.q = radiusRatio(pos(cur.v[0]), pos(cur.v[1]), pos(cur.v[2]), pos(cur.v[3]));
+    cur.up = -1;
+    qPool[slot] = cur;
+    return cur.q;
+  };
+  // vol6 > 0 ? tetQ(t) : -1 (vol6 = tetVolume6Here(mesh, t)), the sign cached with q*.
+  // (An entry is only made where vol6 > 0, as tetQ is only asked there.)
+  auto tetQUp = [&](int t) {
+    QEntry cur;
+    for (int k = 0; k < 4; ++k) {
+      cur.v[k] = mesh.T(t, k);
+      cur.ver[k] = nodeVer[cur.v[k]];
+    }
+    std::int32_t& slot = qSlot[t];
+    if (slot >= 0) {
+      QEntry& e = qPool[slot];
+      if (std::equal(cur.v, cur.v + 4, e.v) && std::equal(cur.ver, cur.ver + 4, e.ver)) {
+        if (e.up < 0) e.up = tetVolume6Here(mesh, t) > 0 ? 1 : 0;
+        return e.up ? e.q : -1.0;
+      }
+    }
+    if (!(tetVolume6Here(mesh, t) > 0)) return -1.0;
+    if (slot < 0) {
+      slot = static_cast<std::int32_t>(qPool.size());
+      qPool.emplace_back();
+    }
+    cur.q = radiusRatio(pos(cur.v[0]), pos(cur.v[1]), pos(cur.v[2]), pos(cur.v[3]));
+    cur.up = 1;
     qPool[slot] = cur;
     return cur.q;
   };
   // Quality of tet t with node n placed at y; negative when it would invert or go flat.
-  auto tetQAt = [&](int t, int n, const Vec3& y) {
-    Vec3 p[4];
-    for (int k = 0; k < 4; ++k) p[k] = mesh.T(t, k) == n ? y : pos(mesh.T(t, k));
-    return radiusRatioOriented(p[0], p[1], p[2], p[3]);  // -1 where not (p1-p0).((p2-p0)x(p3-p0)) > 0
+  // (The corners passed directly, n's replaced by y: the same values as a copy.)
+  auto tetQAt = [&](int t, int n, const Vec3& y) {  // -1 where not (p1-p0).((p2-p0)x(p3-p0)) > 0
+    const int a = mesh.T(t, 0), b = mesh.T(t, 1), c = mesh.T(t, 2), d = mesh.T(t, 3);
+    if (a == n) return radiusRatioOriented(y, pos(b), pos(c), pos(d));
+    if (b == n) return radiusRatioOriented(pos(a), y, pos(c), pos(d));
+    if (c == n) return radiusRatioOriented(pos(a), pos(b), y, pos(d));
+    if (d == n) return radiusRatioOriented(pos(a), pos(b), pos(c), y);
+    return radiusRatioOriented(pos(a), pos(b), pos(c), pos(d));
   };
   // Worst q* around n where it is (tetQAt at its own position, through the cache).
   auto starWorst = [&](int n, int* worstTet) {
@@ -311,8 +343,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s) {
       const int t = (*s);
       if ((*dead)[t]) continue;
-      const double vol6 = tetVolume6Here(mesh, t);  // (p1 - p0).dot((p2 - p0).cross(p3 - p0))
-      const double qt = vol6 > 0 ? tetQ(t) : -1.0;
+      const double qt = tetQUp(t);  // -1 where not (p1 - p0).dot((p2 - p0).cross(p3 - p0)) > 0
       if (qt < q) {
         q = qt;
         if (worstTet) *worstTet = (*s);
@@ -1444,8 +1475,10 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     // Sorted by length (then ends); an edge comes once per poor tet around it: one candidate
     // per (u, v), short if any of its copies is (a short edge's test accepts what the other
     // accepts, and copies would be tried one after the other on the same mesh).
-    auto byKey = [](const Cand& p, const Cand& q) {
-      return p.len != q.len ? p.len < q.len : p.u != q.u ? p.u < q.u : p.v < q.v;
+    auto byKey = [](const Cand& p, const Cand& q) {  // (the lengths are finite)
+      if (p.len < q.len) return true;
+      if (q.len < p.len) return false;
+      return p.u != q.u ? p.u < q.u : p.v < q.v;
     };
     // (c sorted by byKey: copies of a candidate are neighbours, in any order; the first
     // copy's fields are kept, the same for every copy but the tet, which the loop below does
@@ -2077,6 +2110,13 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   std::vector<std::uint8_t> didMove(N, 0);
   std::vector<std::int32_t> movedNow;
   std::vector<double> starVolume;  // per node in the move loop, filled when first needed
+  struct StarVolTet {  // per live star tet in the move loop's volume check (see there)
+    double p[3][4];    // the corners' x, y, z
+    double a[3], b[3], e[3], nrm[3];  // p1 - p0, p2 - p0, p3 - p0, b x e (where kn != 0)
+    double old;        // its volume where n is
+    int kn;            // n's corner
+  };
+  std::vector<StarVolTet> starVol;
   int it = 0;
   bfStart.assign(N, -1);  // constraintOf keeps the boundary faces per node (see there)
   bfLen.assign(N, 0);
@@ -2106,31 +2146,52 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       double sum = 0;
       int deg = 0;
       Vec3 force = Vec3::Zero();
-      for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s)
-        for (int k = 0; k < 4 && !(*dead)[(*s)]; ++k) {
+      for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s) {
+        if ((*dead)[(*s)]) continue;
+        for (int k = 0; k < 4; ++k) {
           const int m = mesh.T((*s), k);
           if (m == n) continue;
           sum += (pos(m) - x).norm();
           ++deg;
         }
+      }
       if (deg == 0) continue;
       const double h = sum / deg;
       scale = std::max(scale, h);
-      for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s)
-        for (int k = 0; k < 4 && !(*dead)[(*s)]; ++k) {
+      for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s) {
+        if ((*dead)[(*s)]) continue;
+        for (int k = 0; k < 4; ++k) {
           const int m = mesh.T((*s), k);
           if (m == n) continue;
           const Vec3 d = pos(m) - x;
           const double len = d.norm();
           if (len > 0) force += (len - h) * d / len;
         }
+      }
+      // The worst tet's corners, n's at wtK (for tetQAt(wt, n, y) below: the same values).
+      Vec3 wtP[4];
+      int wtK = -1;
+      for (int k = 0; k < 4; ++k) {
+        const int v = mesh.T(wt, k);
+        wtP[k] = pos(v);
+        if (v == n) wtK = k;
+      }
+      auto wtQAt = [&](const Vec3& y) {
+        switch (wtK) {
+          case 0: return radiusRatioOriented(y, wtP[1], wtP[2], wtP[3]);
+          case 1: return radiusRatioOriented(wtP[0], y, wtP[2], wtP[3]);
+          case 2: return radiusRatioOriented(wtP[0], wtP[1], y, wtP[3]);
+          case 3: return radiusRatioOriented(wtP[0], wtP[1], wtP[2], y);
+          default: return radiusRatioOriented(wtP[0], wtP[1], wtP[2], wtP[3]);  // (n not a corner: not expected)
+        }
+      };
       // Gradient of the worst element's q* (central differences).
       Vec3 grad = Vec3::Zero();
       const double fd = 1e-4 * h;
       for (int a = 0; a < 3; ++a) {
         Vec3 e = Vec3::Zero();
         e[a] = fd;
-        grad[a] = (tetQAt(wt, n, x + e) - tetQAt(wt, n, x - e)) / (2 * fd);
+        grad[a] = (wtQAt(x + e) - wtQAt(x - e)) / (2 * fd);
       }
       grad = unitIn(grad);
       // Push: away from the face opposite n in its worst tet.
@@ -2208,44 +2269,82 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
           // caches and starAbove's lastBelow only skip or order work), so any order gives the
           // same moves: the cheapest first (the worst tet, which starAbove tries first anyway),
           // then the volume check (it fails often), the surface queries after it.
-          const double qFirst = tetQAt(wt, n, y);
+          const double qFirst = wtQAt(y);
           if (!(qFirst > best)) continue;
           // Moves on a curved surface change the volume a little (the faces are chords): within the budget.
           double dv = 0;
           if (curved && (c.kind == Freedom::Surface || c.kind == Freedom::Fan || c.kind == Freedom::Ridge)) {
-            if (starVolume.empty())  // the star's volumes where n is (the same for every candidate)
-              for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s)
+            if (starVolume.empty()) {  // the star's volumes where n is (the same for every candidate)
+              // With them, per live star tet the parts of its volume expression that do not
+              // depend on n's position (the corners, the differences and the cross product of
+              // the fixed corners: the same operations on the same values as below).
+              const double* cx = mesh.X.col(0).data();
+              const double* cy = mesh.X.col(1).data();
+              const double* cz = mesh.X.col(2).data();
+              starVol.clear();
+              for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s) {
                 starVolume.push_back((*dead)[*s] ? 0.0 : tetVolumeHere(mesh, *s));
+                if ((*dead)[*s]) continue;
+                StarVolTet sv;
+                double px[4], py[4], pz[4];
+                sv.kn = -1;
+                for (int k = 0; k < 4; ++k) {
+                  const int v = mesh.T(*s, k);
+                  if (v == n && sv.kn < 0) sv.kn = k;
+                  px[k] = cx[v];
+                  py[k] = cy[v];
+                  pz[k] = cz[v];
+                }
+                sv.old = starVolume.back();
+                for (int k = 0; k < 4; ++k) {
+                  sv.p[0][k] = px[k];
+                  sv.p[1][k] = py[k];
+                  sv.p[2][k] = pz[k];
+                }
+                if (sv.kn != 0) {
+                  sv.a[0] = px[1] - px[0], sv.a[1] = py[1] - py[0], sv.a[2] = pz[1] - pz[0];
+                  sv.b[0] = px[2] - px[0], sv.b[1] = py[2] - py[0], sv.b[2] = pz[2] - pz[0];
+                  sv.e[0] = px[3] - px[0], sv.e[1] = py[3] - py[0], sv.e[2] = pz[3] - pz[0];
+                  const double bx = sv.b[0], by = sv.b[1], bz = sv.b[2];
+                  const double ex = sv.e[0], ey = sv.e[1], ez = sv.e[2];
+                  sv.nrm[0] = by * ez - bz * ey, sv.nrm[1] = bz * ex - bx * ez, sv.nrm[2] = bx * ey - by * ex;
+                }
+                starVol.push_back(sv);
+              }
+            }
             // (The volume of each tet with n at y in scalars, as tetVolumeHere: the same value
             // as the vector expression (p1 - p0).dot((p2 - p0).cross(p3 - p0)).)
-            const double* oldVolume = starVolume.data();
-            const double* cx = mesh.X.col(0).data();
-            const double* cy = mesh.X.col(1).data();
-            const double* cz = mesh.X.col(2).data();
-            for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s, ++oldVolume) {
-              if ((*dead)[*s]) continue;
-              double px[4], py[4], pz[4];
-              for (int k = 0; k < 4; ++k) {
-                const int v = mesh.T(*s, k);
-                const bool here = v == n;
-                px[k] = here ? y[0] : cx[v];
-                py[k] = here ? y[1] : cy[v];
-                pz[k] = here ? y[2] : cz[v];
+            for (const StarVolTet& sv : starVol) {
+              double ax, ay, az, bx, by, bz, ex, ey, ez, vol6;
+              if (sv.kn == 0) {
+                ax = sv.p[0][1] - y[0], ay = sv.p[1][1] - y[1], az = sv.p[2][1] - y[2];
+                bx = sv.p[0][2] - y[0], by = sv.p[1][2] - y[1], bz = sv.p[2][2] - y[2];
+                ex = sv.p[0][3] - y[0], ey = sv.p[1][3] - y[1], ez = sv.p[2][3] - y[2];
+              } else {
+                ax = sv.a[0], ay = sv.a[1], az = sv.a[2];
+                bx = sv.b[0], by = sv.b[1], bz = sv.b[2];
+                ex = sv.e[0], ey = sv.e[1], ez = sv.e[2];
+                const double dx = y[0] - sv.p[0][0], dy = y[1] - sv.p[1][0], dz = y[2] - sv.p[2][0];
+                if (sv.kn == 1) ax = dx, ay = dy, az = dz;
+                else if (sv.kn == 2) bx = dx, by = dy, bz = dz;
+                else if (sv.kn == 3) ex = dx, ey = dy, ez = dz;
               }
-              const double ax = px[1] - px[0], ay = py[1] - py[0], az = pz[1] - pz[0];
-              const double bx = px[2] - px[0], by = py[2] - py[0], bz = pz[2] - pz[0];
-              const double ex = px[3] - px[0], ey = py[3] - py[0], ez = pz[3] - pz[0];
-              const double nx = by * ez - bz * ey, ny = bz * ex - bx * ez, nz = bx * ey - by * ex;
-              const double vol6 = (ax * nx + ay * ny) + az * nz;
+              if (sv.kn == 1 || sv.kn < 0) {  // (kn < 0: n not a corner, not expected)
+                vol6 = (ax * sv.nrm[0] + ay * sv.nrm[1]) + az * sv.nrm[2];
+              } else {
+                const double nx = by * ez - bz * ey, ny = bz * ex - bx * ez, nz = bx * ey - by * ex;
+                vol6 = (ax * nx + ay * ny) + az * nz;
+              }
 #ifdef HYSIM_CHECK_EXACT
               {
                 Vec3 p[4];
-                for (int k = 0; k < 4; ++k) p[k] = mesh.T(*s, k) == n ? y : pos(mesh.T(*s, k));
+                for (int k = 0; k < 4; ++k)
+                  p[k] = k == sv.kn ? y : Vec3(sv.p[0][k], sv.p[1][k], sv.p[2][k]);
                 const double ref = (p[1] - p[0]).dot((p[2] - p[0]).cross(p[3] - p[0]));
                 if (std::memcmp(&ref, &vol6, sizeof vol6) != 0) std::abort();
               }
 #endif
-              dv += vol6 / 6.0 - *oldVolume;
+              dv += vol6 / 6.0 - sv.old;
             }
             if (!moveBudget.fits(dv) || std::abs(dv) > options.move_volume_fraction * edgeTet) continue;
           }
