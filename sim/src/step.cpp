@@ -1,5 +1,8 @@
 // The fixed step. Nothing here allocates: every buffer is sized when the model is built.
+#include <immintrin.h>
+
 #include <cmath>
+#include <cstddef>
 
 #include "hysim/sim/model.hpp"
 #include "implicit_solver.hpp"
@@ -7,38 +10,76 @@
 namespace hysim::sim {
 namespace {
 
-// Force of every step spring on its a end (F_b = -F_a), from positions and velocities.
-// The loop has no scatter, so it vectorises: compiled twice, for baseline x86-64 and for
-// AVX2 (gathers, 4 springs at a time), the AVX2 one used where the CPU has it. Both give
-// bit-identical results: only IEEE-exact operations, no FMA (ISO C++ mode keeps
-// contraction off and the AVX2 build does not enable FMA). A test checks this.
-[[gnu::always_inline]] inline void springForcesBody(int count, const std::int32_t* __restrict sa,
-                                                    const std::int32_t* __restrict sb, const double* __restrict rest,
-                                                    const double* __restrict stiffness,
-                                                    const double* __restrict damping, const double* __restrict X,
-                                                    const double* __restrict V, double* __restrict fx,
-                                                    double* __restrict fy, double* __restrict fz) {
-  for (int s = 0; s < count; ++s) {
-    const int a = 3 * sa[s], b = 3 * sb[s];  // row-major #N x 3
-    const double dx = X[b] - X[a], dy = X[b + 1] - X[a + 1], dz = X[b + 2] - X[a + 2];
-    // + 1e-300 keeps a zero-length spring finite (direction 0) without a branch.
-    const double len = std::sqrt(dx * dx + dy * dy + dz * dz + 1e-300);
-    const double inv = 1.0 / len;
-    const double ux = dx * inv, uy = dy * inv, uz = dz * inv;
-    const double rel = (V[b] - V[a]) * ux + (V[b + 1] - V[a + 1]) * uy + (V[b + 2] - V[a + 2]) * uz;
-    const double mag = stiffness[s] * (len - rest[s]) + damping[s] * rel;
-    fx[s] = mag * ux;
-    fy[s] = mag * uy;
-    fz[s] = mag * uz;
-  }
+// Force of every step spring on its a end (F_b = -F_a), from positions and velocities, as
+// rows (x, y, z, 0) of F. Compiled for baseline x86-64 (one spring at a time) and, by hand,
+// for AVX2 (gathers, 4 springs at a time, the four results transposed into rows), the AVX2 one
+// used where the CPU has it. Both give bit-identical results: the same IEEE-exact operations
+// in the same order, no FMA (ISO C++ mode keeps contraction off and the AVX2 build does not
+// enable FMA). A test checks this.
+[[gnu::always_inline]] inline void springForceOne(int s, const std::int32_t* __restrict sa,
+                                                  const std::int32_t* __restrict sb, const double* __restrict rest,
+                                                  const double* __restrict stiffness,
+                                                  const double* __restrict damping, const double* __restrict X,
+                                                  const double* __restrict V, double* __restrict F) {
+  const int a = 3 * sa[s], b = 3 * sb[s];  // row-major #N x 3
+  const double dx = X[b] - X[a], dy = X[b + 1] - X[a + 1], dz = X[b + 2] - X[a + 2];
+  // + 1e-300 keeps a zero-length spring finite (direction 0) without a branch.
+  const double len = std::sqrt(dx * dx + dy * dy + dz * dz + 1e-300);
+  const double inv = 1.0 / len;
+  const double ux = dx * inv, uy = dy * inv, uz = dz * inv;
+  const double rel = (V[b] - V[a]) * ux + (V[b + 1] - V[a + 1]) * uy + (V[b + 2] - V[a + 2]) * uz;
+  const double mag = stiffness[s] * (len - rest[s]) + damping[s] * rel;
+  double* row = F + 4 * static_cast<std::ptrdiff_t>(s);
+  row[0] = mag * ux;
+  row[1] = mag * uy;
+  row[2] = mag * uz;
+  row[3] = 0.0;
 }
 
 #define HYSIM_SPRING_ARGS                                                                                    \
-  int count, const std::int32_t *sa, const std::int32_t *sb, const double *rest, const double *stiffness, \
-      const double *damping, const double *X, const double *V, double *fx, double *fy, double *fz
-void springForcesBaseline(HYSIM_SPRING_ARGS) { springForcesBody(count, sa, sb, rest, stiffness, damping, X, V, fx, fy, fz); }
+  int count, const std::int32_t *__restrict sa, const std::int32_t *__restrict sb, const double *__restrict rest, \
+      const double *__restrict stiffness, const double *__restrict damping, const double *__restrict X,           \
+      const double *__restrict V, double *__restrict F
+void springForcesBaseline(HYSIM_SPRING_ARGS) {
+  for (int s = 0; s < count; ++s) springForceOne(s, sa, sb, rest, stiffness, damping, X, V, F);
+}
+// Four doubles from base[idx[0..3]]: scalar loads and inserts, faster than vgatherdpd here.
+[[gnu::target("avx2"), gnu::always_inline]] inline __m256d gather4(const double* base, const std::ptrdiff_t* idx) {
+  return _mm256_setr_pd(base[idx[0]], base[idx[1]], base[idx[2]], base[idx[3]]);
+}
 [[gnu::target("avx2")]] void springForcesAvx2(HYSIM_SPRING_ARGS) {
-  springForcesBody(count, sa, sb, rest, stiffness, damping, X, V, fx, fy, fz);
+  int s = 0;
+  const __m256d tiny = _mm256_set1_pd(1e-300), one = _mm256_set1_pd(1.0), zero = _mm256_setzero_pd();
+  for (; s + 4 <= count; s += 4) {
+    const std::ptrdiff_t ia[4] = {3 * sa[s], 3 * sa[s + 1], 3 * sa[s + 2], 3 * sa[s + 3]};
+    const std::ptrdiff_t ib[4] = {3 * sb[s], 3 * sb[s + 1], 3 * sb[s + 2], 3 * sb[s + 3]};
+    const __m256d dx = _mm256_sub_pd(gather4(X, ib), gather4(X, ia));
+    const __m256d dy = _mm256_sub_pd(gather4(X + 1, ib), gather4(X + 1, ia));
+    const __m256d dz = _mm256_sub_pd(gather4(X + 2, ib), gather4(X + 2, ia));
+    const __m256d len2 = _mm256_add_pd(
+        _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(dx, dx), _mm256_mul_pd(dy, dy)), _mm256_mul_pd(dz, dz)), tiny);
+    const __m256d len = _mm256_sqrt_pd(len2);
+    const __m256d inv = _mm256_div_pd(one, len);
+    const __m256d ux = _mm256_mul_pd(dx, inv), uy = _mm256_mul_pd(dy, inv), uz = _mm256_mul_pd(dz, inv);
+    const __m256d vx = _mm256_sub_pd(gather4(V, ib), gather4(V, ia));
+    const __m256d vy = _mm256_sub_pd(gather4(V + 1, ib), gather4(V + 1, ia));
+    const __m256d vz = _mm256_sub_pd(gather4(V + 2, ib), gather4(V + 2, ia));
+    const __m256d rel =
+        _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(vx, ux), _mm256_mul_pd(vy, uy)), _mm256_mul_pd(vz, uz));
+    const __m256d mag =
+        _mm256_add_pd(_mm256_mul_pd(_mm256_loadu_pd(stiffness + s), _mm256_sub_pd(len, _mm256_loadu_pd(rest + s))),
+                      _mm256_mul_pd(_mm256_loadu_pd(damping + s), rel));
+    const __m256d fx = _mm256_mul_pd(mag, ux), fy = _mm256_mul_pd(mag, uy), fz = _mm256_mul_pd(mag, uz);
+    // (fx, fy, fz) of springs s..s+3 into rows (fx_i, fy_i, fz_i, 0).
+    const __m256d t0 = _mm256_unpacklo_pd(fx, fy), t1 = _mm256_unpackhi_pd(fx, fy);  // s, s+2 | s+1, s+3
+    const __m256d t2 = _mm256_unpacklo_pd(fz, zero), t3 = _mm256_unpackhi_pd(fz, zero);
+    double* row = F + 4 * static_cast<std::ptrdiff_t>(s);
+    _mm256_store_pd(row, _mm256_permute2f128_pd(t0, t2, 0x20));
+    _mm256_store_pd(row + 4, _mm256_permute2f128_pd(t1, t3, 0x20));
+    _mm256_store_pd(row + 8, _mm256_permute2f128_pd(t0, t2, 0x31));
+    _mm256_store_pd(row + 12, _mm256_permute2f128_pd(t1, t3, 0x31));
+  }
+  for (; s < count; ++s) springForceOne(s, sa, sb, rest, stiffness, damping, X, V, F);
 }
 #undef HYSIM_SPRING_ARGS
 
@@ -47,41 +88,94 @@ bool cpuHasAvx2() {
   return has;
 }
 
-// f = gravity + external + spring and spring-damping forces (free nodes only: anchored
-// nodes never move, their forces are not needed).
-void accumulateForces(const Model& m, const NodeVectors& x, const NodeVectors& v, const StepInput& in,
-                      State& s) {
+bool useAvx2(const Model& m) { return m.options.simd && cpuHasAvx2(); }
+
+void springForces(const Model& m, const NodeVectors& x, const NodeVectors& v, State& s) {
   const StepSprings& st = m.step_springs;
-  Eigen::MatrixX3d& sf = s.spring_force;
-  auto* spring_forces = (m.options.simd && cpuHasAvx2()) ? springForcesAvx2 : springForcesBaseline;
+  auto* spring_forces = useAvx2(m) ? springForcesAvx2 : springForcesBaseline;
   spring_forces(st.size(), st.a.data(), st.b.data(), st.rest_length.data(), st.stiffness.data(), st.damping.data(),
-               x.data(), v.data(), sf.col(0).data(), sf.col(1).data(), sf.col(2).data());
-  const double* fx = sf.col(0).data();
-  const double* fy = sf.col(1).data();
-  const double* fz = sf.col(2).data();
+                x.data(), v.data(), s.spring_force.data());
+}
+
+// One substep's forces and update, node by node: f = gravity + external + the spring and
+// spring-damping forces (free nodes; anchored nodes never move, their f is 0), then
+// v = (v + h f / m) * drag and x += h v. A node's update reads only the spring forces (from
+// the positions before the substep) and its own rows, so updating node by node is the same as
+// summing every force first. The AVX2 version sums the rows (x, y, z, 0) in one register, the
+// same additions in the same order.
+#define HYSIM_UPDATE_ARGS                                                                                        \
+  const Model &m, const double *__restrict ext, double h, double drag, const double *__restrict F, double *__restrict x, \
+      double *__restrict v, double *__restrict f
+void integrateBaseline(HYSIM_UPDATE_ARGS) {
+  const StepSprings& st = m.step_springs;
   const Eigen::Vector3d& g = m.options.gravity;
-  const double* ext = in.external_force != nullptr ? in.external_force->data() : nullptr;
-  double* F = s.f.data();
+  const double* im = m.inv_mass.data();
   for (int i = 0; i < m.num_nodes; ++i) {
-    if (m.fixed[i]) continue;
-    double f0 = m.mass[i] * g[0], f1 = m.mass[i] * g[1], f2 = m.mass[i] * g[2];
-    if (ext != nullptr) {
-      f0 += ext[3 * i];
-      f1 += ext[3 * i + 1];
-      f2 += ext[3 * i + 2];
+    double f0 = 0.0, f1 = 0.0, f2 = 0.0;
+    if (!m.fixed[i]) {
+      f0 = m.mass[i] * g[0];
+      f1 = m.mass[i] * g[1];
+      f2 = m.mass[i] * g[2];
+      if (ext != nullptr) {
+        f0 += ext[3 * i];
+        f1 += ext[3 * i + 1];
+        f2 += ext[3 * i + 2];
+      }
+      for (int e = st.node_offset[i]; e < st.node_offset[i + 1]; ++e) {
+        const double* row = F + 4 * static_cast<std::ptrdiff_t>(st.incident[e]);
+        const double sign = st.sign[e];
+        f0 += sign * row[0];
+        f1 += sign * row[1];
+        f2 += sign * row[2];
+      }
     }
-    for (int e = st.node_offset[i]; e < st.node_offset[i + 1]; ++e) {
-      const int k = st.incident[e];
-      const double sign = st.sign[e];
-      f0 += sign * fx[k];
-      f1 += sign * fy[k];
-      f2 += sign * fz[k];
-    }
-    F[3 * i] = f0;
-    F[3 * i + 1] = f1;
-    F[3 * i + 2] = f2;
+    const double hm = h * im[i];  // fixed nodes: inv_mass 0, so v stays 0
+    const int c = 3 * i;
+    f[c] = f0;
+    f[c + 1] = f1;
+    f[c + 2] = f2;
+    v[c] = (v[c] + hm * f0) * drag;
+    v[c + 1] = (v[c + 1] + hm * f1) * drag;
+    v[c + 2] = (v[c + 2] + hm * f2) * drag;
+    x[c] += h * v[c];
+    x[c + 1] += h * v[c + 1];
+    x[c + 2] += h * v[c + 2];
   }
 }
+[[gnu::target("avx2")]] void integrateAvx2(HYSIM_UPDATE_ARGS) {
+  const StepSprings& st = m.step_springs;
+  const Eigen::Vector3d& g = m.options.gravity;
+  const __m256d gv = _mm256_setr_pd(g[0], g[1], g[2], 0.0);
+  const double* im = m.inv_mass.data();
+  const std::int32_t* off = st.node_offset.data();
+  const std::int32_t* incident = st.incident.data();
+  const double* sign = st.sign.data();
+  alignas(32) double sum[4];
+  for (int i = 0; i < m.num_nodes; ++i) {
+    __m256d acc = _mm256_setzero_pd();
+    if (!m.fixed[i]) {
+      acc = _mm256_mul_pd(_mm256_set1_pd(m.mass[i]), gv);
+      if (ext != nullptr) acc = _mm256_add_pd(acc, _mm256_setr_pd(ext[3 * i], ext[3 * i + 1], ext[3 * i + 2], 0.0));
+      for (int e = off[i]; e < off[i + 1]; ++e) {
+        const __m256d row = _mm256_load_pd(F + 4 * static_cast<std::ptrdiff_t>(incident[e]));
+        acc = _mm256_add_pd(acc, _mm256_mul_pd(_mm256_set1_pd(sign[e]), row));
+      }
+    }
+    _mm256_store_pd(sum, acc);
+    const double hm = h * im[i];
+    const int c = 3 * i;
+    f[c] = sum[0];
+    f[c + 1] = sum[1];
+    f[c + 2] = sum[2];
+    v[c] = (v[c] + hm * sum[0]) * drag;
+    v[c + 1] = (v[c + 1] + hm * sum[1]) * drag;
+    v[c + 2] = (v[c + 2] + hm * sum[2]) * drag;
+    x[c] += h * v[c];
+    x[c + 1] += h * v[c + 1];
+    x[c + 2] += h * v[c + 2];
+  }
+}
+#undef HYSIM_UPDATE_ARGS
 
 // Counts a warning and freezes the state when anything became non-finite or too fast.
 bool checkHealth(const Model& m, State& s) {
@@ -100,21 +194,12 @@ bool checkHealth(const Model& m, State& s) {
 void stepSymplecticEuler(const Model& m, State& s, const StepInput& in) {
   const double h = m.substep;
   const double drag = 1.0 / (1.0 + h * m.options.drag_per_s);  // implicit drag: stable for any h
-  const int n = m.num_nodes;
+  auto* integrate = useAvx2(m) ? integrateAvx2 : integrateBaseline;
   for (int sub = 0; sub < m.substeps; ++sub) {
     if (in.refresh_external != nullptr) in.refresh_external(in.context, s.x, s.v);
-    accumulateForces(m, s.x, s.v, in, s);
-    double* v = s.v.data();
-    double* x = s.x.data();
-    const double* f = s.f.data();
-    const double* im = m.inv_mass.data();
-    for (int i = 0; i < n; ++i) {
-      const double hm = h * im[i];  // fixed nodes: inv_mass 0, so v stays 0
-      for (int c = 3 * i; c < 3 * i + 3; ++c) {
-        v[c] = (v[c] + hm * f[c]) * drag;
-        x[c] += h * v[c];
-      }
-    }
+    springForces(m, s.x, s.v, s);
+    integrate(m, in.external_force != nullptr ? in.external_force->data() : nullptr, h, drag, s.spring_force.data(),
+              s.x.data(), s.v.data(), s.f.data());
   }
 }
 

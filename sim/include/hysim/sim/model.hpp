@@ -6,8 +6,10 @@
 //   length mm, mass g, time s  =>  force g*mm/s^2 = 1 uN, stiffness g/s^2 (= mN/m),
 //   pressure / Young's modulus g/(mm*s^2) = 1 Pa, density g/mm^3 (1 g/cm^3 = 1e-3 g/mm^3).
 #include <Eigen/Core>
+#include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <new>
 #include <string>
 #include <vector>
 
@@ -95,6 +97,21 @@ struct Model {
   std::shared_ptr<const ImplicitSolver> implicit;  // set when integrator == ImplicitEuler
 };
 
+// 64-byte aligned storage for the step's vector loads.
+template <class T>
+struct AlignedAllocator {
+  using value_type = T;
+  AlignedAllocator() = default;
+  template <class U>
+  AlignedAllocator(const AlignedAllocator<U>&) {}
+  T* allocate(std::size_t n) { return static_cast<T*>(::operator new(n * sizeof(T), std::align_val_t(64))); }
+  void deallocate(T* p, std::size_t) { ::operator delete(p, std::align_val_t(64)); }
+  template <class U>
+  bool operator==(const AlignedAllocator<U>&) const { return true; }
+  template <class U>
+  bool operator!=(const AlignedAllocator<U>&) const { return false; }
+};
+
 struct State {
   NodeVectors x;        // #N x 3 positions, mm
   NodeVectors v;        // #N x 3 velocities, mm/s
@@ -102,7 +119,9 @@ struct State {
   NodeVectors scratch0; // #N x 3 integrator scratch (sized when the model is built)
   NodeVectors scratch1; // #N x 3
   NodeVectors scratch2; // #N x 3
-  Eigen::MatrixX3d spring_force;  // #M x 3 column-major: force of each step spring on its a end
+  // #M x 4 (x, y, z, 0), rows 32-byte aligned: force of each step spring on its a end (one
+  // 32-byte load per incident spring when the forces are summed per node)
+  std::vector<double, AlignedAllocator<double>> spring_force;
   Eigen::MatrixX3d solve0;  // #N x 3 column-major: the sparse triangular solves work in place
   Eigen::MatrixX3d solve1;  // on column-major right-hand sides without temporaries
   std::uint64_t steps = 0;
