@@ -12,7 +12,8 @@ namespace {
 
 // Force of every step spring on its a end (F_b = -F_a), from positions and velocities, as
 // rows (x, y, z, 0) of F. Compiled for baseline x86-64 (one spring at a time) and, by hand,
-// for AVX2 (gathers, 4 springs at a time, the four results transposed into rows), the AVX2 one
+// for AVX2 (4 springs at a time: their node rows loaded by 16- and 8-byte loads and
+// unpacked, which beats vgatherdpd here; the four results unpacked into rows), the AVX2 one
 // used where the CPU has it. Both give bit-identical results: the same IEEE-exact operations
 // in the same order, no FMA (ISO C++ mode keeps contraction off and the AVX2 build does not
 // enable FMA). A test checks this.
@@ -43,9 +44,21 @@ namespace {
 void springForcesBaseline(HYSIM_SPRING_ARGS) {
   for (int s = 0; s < count; ++s) springForceOne(s, sa, sb, rest, stiffness, damping, X, V, F);
 }
-// Four doubles from base[idx[0..3]]: scalar loads and inserts, faster than vgatherdpd here.
+// Four doubles from base[idx[0..3]] by scalar loads and inserts.
 [[gnu::target("avx2"), gnu::always_inline]] inline __m256d gather4(const double* base, const std::ptrdiff_t* idx) {
   return _mm256_setr_pd(base[idx[0]], base[idx[1]], base[idx[2]], base[idx[3]]);
+}
+// Rows base[idx[j] .. idx[j] + 2] of four springs as (x0..x3), (y0..y3), (z0..z3): x and y by
+// 16-byte loads and two unpacks, z by gather4.
+[[gnu::target("avx2"), gnu::always_inline]] inline void gatherRows(const double* base, const std::ptrdiff_t* idx,
+                                                                  __m256d& x, __m256d& y, __m256d& z) {
+  const __m256d r02 =
+      _mm256_insertf128_pd(_mm256_castpd128_pd256(_mm_loadu_pd(base + idx[0])), _mm_loadu_pd(base + idx[2]), 1);
+  const __m256d r13 =
+      _mm256_insertf128_pd(_mm256_castpd128_pd256(_mm_loadu_pd(base + idx[1])), _mm_loadu_pd(base + idx[3]), 1);
+  x = _mm256_unpacklo_pd(r02, r13);
+  y = _mm256_unpackhi_pd(r02, r13);
+  z = gather4(base + 2, idx);
 }
 [[gnu::target("avx2")]] void springForcesAvx2(HYSIM_SPRING_ARGS) {
   int s = 0;
@@ -53,17 +66,18 @@ void springForcesBaseline(HYSIM_SPRING_ARGS) {
   for (; s + 4 <= count; s += 4) {
     const std::ptrdiff_t ia[4] = {3 * sa[s], 3 * sa[s + 1], 3 * sa[s + 2], 3 * sa[s + 3]};
     const std::ptrdiff_t ib[4] = {3 * sb[s], 3 * sb[s + 1], 3 * sb[s + 2], 3 * sb[s + 3]};
-    const __m256d dx = _mm256_sub_pd(gather4(X, ib), gather4(X, ia));
-    const __m256d dy = _mm256_sub_pd(gather4(X + 1, ib), gather4(X + 1, ia));
-    const __m256d dz = _mm256_sub_pd(gather4(X + 2, ib), gather4(X + 2, ia));
+    __m256d xa, ya, za, xb, yb, zb;
+    gatherRows(X, ia, xa, ya, za);
+    gatherRows(X, ib, xb, yb, zb);
+    const __m256d dx = _mm256_sub_pd(xb, xa), dy = _mm256_sub_pd(yb, ya), dz = _mm256_sub_pd(zb, za);
     const __m256d len2 = _mm256_add_pd(
         _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(dx, dx), _mm256_mul_pd(dy, dy)), _mm256_mul_pd(dz, dz)), tiny);
     const __m256d len = _mm256_sqrt_pd(len2);
     const __m256d inv = _mm256_div_pd(one, len);
     const __m256d ux = _mm256_mul_pd(dx, inv), uy = _mm256_mul_pd(dy, inv), uz = _mm256_mul_pd(dz, inv);
-    const __m256d vx = _mm256_sub_pd(gather4(V, ib), gather4(V, ia));
-    const __m256d vy = _mm256_sub_pd(gather4(V + 1, ib), gather4(V + 1, ia));
-    const __m256d vz = _mm256_sub_pd(gather4(V + 2, ib), gather4(V + 2, ia));
+    gatherRows(V, ia, xa, ya, za);
+    gatherRows(V, ib, xb, yb, zb);
+    const __m256d vx = _mm256_sub_pd(xb, xa), vy = _mm256_sub_pd(yb, ya), vz = _mm256_sub_pd(zb, za);
     const __m256d rel =
         _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(vx, ux), _mm256_mul_pd(vy, uy)), _mm256_mul_pd(vz, uz));
     const __m256d mag =
@@ -74,10 +88,14 @@ void springForcesBaseline(HYSIM_SPRING_ARGS) {
     const __m256d t0 = _mm256_unpacklo_pd(fx, fy), t1 = _mm256_unpackhi_pd(fx, fy);  // s, s+2 | s+1, s+3
     const __m256d t2 = _mm256_unpacklo_pd(fz, zero), t3 = _mm256_unpackhi_pd(fz, zero);
     double* row = F + 4 * static_cast<std::ptrdiff_t>(s);
-    _mm256_store_pd(row, _mm256_permute2f128_pd(t0, t2, 0x20));
-    _mm256_store_pd(row + 4, _mm256_permute2f128_pd(t1, t3, 0x20));
-    _mm256_store_pd(row + 8, _mm256_permute2f128_pd(t0, t2, 0x31));
-    _mm256_store_pd(row + 12, _mm256_permute2f128_pd(t1, t3, 0x31));
+    _mm_store_pd(row, _mm256_castpd256_pd128(t0));
+    _mm_store_pd(row + 2, _mm256_castpd256_pd128(t2));
+    _mm_store_pd(row + 4, _mm256_castpd256_pd128(t1));
+    _mm_store_pd(row + 6, _mm256_castpd256_pd128(t3));
+    _mm_store_pd(row + 8, _mm256_extractf128_pd(t0, 1));
+    _mm_store_pd(row + 10, _mm256_extractf128_pd(t2, 1));
+    _mm_store_pd(row + 12, _mm256_extractf128_pd(t1, 1));
+    _mm_store_pd(row + 14, _mm256_extractf128_pd(t3, 1));
   }
   for (; s < count; ++s) springForceOne(s, sa, sb, rest, stiffness, damping, X, V, F);
 }
