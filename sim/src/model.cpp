@@ -265,7 +265,7 @@ void sizeStepArrays(const Model& model, State& state) {
   state.scratch0.resize(n, 3);
   state.scratch1.resize(n, 3);
   state.scratch2.resize(n, 3);
-  state.spring_force.assign(4 * static_cast<size_t>(model.step_springs.size()), 0.0);
+  state.spring_force.resize(4 * static_cast<size_t>(model.step_springs.size()));  // written by every substep first
   state.solve0.resize(n, 3);
   state.solve1.resize(n, 3);
 }

@@ -11,6 +11,7 @@
 #include <memory>
 #include <new>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "hysim/cutting/mesh.hpp"
@@ -97,7 +98,7 @@ struct Model {
   std::shared_ptr<const ImplicitSolver> implicit;  // set when integrator == ImplicitEuler
 };
 
-// 64-byte aligned storage for the step's vector loads.
+// 64-byte aligned storage for the step's vector loads; no zero fill on resize.
 template <class T>
 struct AlignedAllocator {
   using value_type = T;
@@ -106,6 +107,13 @@ struct AlignedAllocator {
   AlignedAllocator(const AlignedAllocator<U>&) {}
   T* allocate(std::size_t n) { return static_cast<T*>(::operator new(n * sizeof(T), std::align_val_t(64))); }
   void deallocate(T* p, std::size_t) { ::operator delete(p, std::align_val_t(64)); }
+  // resize() leaves new elements uninitialised (they are written before they are read).
+  template <class U>
+  void construct(U*) noexcept {}
+  template <class U, class... Args>
+  void construct(U* p, Args&&... args) {
+    ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+  }
   template <class U>
   bool operator==(const AlignedAllocator<U>&) const { return true; }
   template <class U>
