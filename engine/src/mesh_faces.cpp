@@ -64,40 +64,34 @@ bool updateFaces(const cutting::TetMesh& before, const std::vector<int>& next_be
       node_old_to_new.size() != static_cast<size_t>(N0)) {
     return false;
   }
-  for (int t = 0; t < T1; ++t)
-    for (int k = 0; k < 4; ++k)
-      if (after.T(t, k) < 0 || after.T(t, k) >= N1) return false;
-  // The old element of each new one, when it has the same nodes in the same order.
+  if (T1 > 0 && (after.T.minCoeff() < 0 || after.T.maxCoeff() >= N1)) return false;
+  // The old element of each new one, when it has the same nodes in the same order; and per
+  // old slot, its neighbour slot and its own new slot (-1: its element was not kept as it
+  // was), side by side: the neighbour's pair is then one memory access (the neighbour is
+  // anywhere in the mesh; the loop below was mostly waiting for those reads). An element is
+  // kept when it maps to a new one with the same nodes: no other old element can map to that
+  // one with the same nodes too (two elements of a valid mesh never have the same nodes).
+  struct OldSlot {
+    int next, now;
+  };
   std::vector<int> old_of(static_cast<size_t>(T1), -1);
+  std::vector<OldSlot> old_slot(4 * static_cast<size_t>(T0));
   for (int t = 0; t < T0; ++t) {
     const int u = element_old_to_new[t];
-    if (u < 0 || u >= T1) continue;
-    bool same = true;
+    bool same = u >= 0 && u < T1;
     for (int k = 0; k < 4 && same; ++k) {
       const int i = before.T(t, k);
       same = i >= 0 && i < N0 && node_old_to_new[i] == after.T(u, k);
     }
     if (same) old_of[u] = t;
+    const size_t s = 4 * static_cast<size_t>(t);
+    const int now = same ? 4 * u : -1;
+    for (int f = 0; f < 4; ++f) old_slot[s + f] = {next_before[s + f], same ? now + f : -1};
   }
   std::vector<std::uint8_t> changed_node(static_cast<size_t>(N1), 0);
   for (int u = 0; u < T1; ++u)
     if (old_of[u] < 0)
       for (int k = 0; k < 4; ++k) changed_node[after.T(u, k)] = 1;
-  // Per old slot, its neighbour slot and its own new slot (-1: its element was not kept as
-  // it was), side by side: the neighbour's pair is then one memory access (the neighbour is
-  // anywhere in the mesh; this loop was mostly waiting for those reads).
-  struct OldSlot {
-    int next, now;
-  };
-  std::vector<OldSlot> old_slot(4 * static_cast<size_t>(T0));
-  for (int t = 0; t < T0; ++t) {
-    const int u = element_old_to_new[t];
-    const bool kept = u >= 0 && u < T1 && old_of[u] == t;
-    for (int f = 0; f < 4; ++f) {
-      const size_t s = 4 * static_cast<size_t>(t) + f;
-      old_slot[s] = {next_before[s], kept ? 4 * u + f : -1};
-    }
-  }
   std::vector<int> out(4 * static_cast<size_t>(T1), -1);
   std::vector<int> open;  // slots to match among themselves
   for (int u = 0; u < T1; ++u) {
