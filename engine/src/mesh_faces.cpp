@@ -92,33 +92,44 @@ bool updateFaces(const cutting::TetMesh& before, const std::vector<int>& next_be
   for (int u = 0; u < T1; ++u)
     if (old_of[u] < 0)
       for (int k = 0; k < 4; ++k) changed_node[after.T(u, k)] = 1;
-  std::vector<int> out(4 * static_cast<size_t>(T1), -1);
+  // Kept neighbours are found per element (its four faces at once, the slots to match among
+  // themselves collected after, in the same order): few values live across the faces, so
+  // the loop keeps them in registers.
+  std::vector<int> out(4 * static_cast<size_t>(T1));  // every entry written here
   std::vector<int> open;  // slots to match among themselves
+  const OldSlot* const slots = old_slot.data();
   for (int u = 0; u < T1; ++u) {
     const int o = old_of[u];
-    for (int f = 0; f < 4; ++f) {
-      const int s = 4 * u + f;
-      if (o < 0) {
-        open.push_back(s);
-        continue;
-      }
-      const int p = old_slot[4 * static_cast<size_t>(o) + f].next;
-      if (p >= 0) {
-        // Kept when both elements are kept as they were and the face had just the two.
-        const OldSlot other = p / 4 < T0 ? old_slot[static_cast<size_t>(p)] : OldSlot{-1, -1};
-        if (other.now >= 0 && other.next == 4 * o + f) {
-          out[s] = other.now;
+    int* const row = out.data() + 4 * static_cast<size_t>(u);
+    unsigned open_faces = 0;
+    if (o < 0) {
+      row[0] = row[1] = row[2] = row[3] = -1;
+      open_faces = 15;
+    } else {
+      const OldSlot* const mine = slots + 4 * static_cast<size_t>(o);
+      for (int f = 0; f < 4; ++f) {
+        const int p = mine[f].next;
+        int now = -1;
+        if (p >= 0) {
+          // Kept when both elements are kept as they were and the face had just the two.
+          const OldSlot other = p / 4 < T0 ? slots[p] : OldSlot{-1, -1};
+          if (other.now >= 0 && other.next == 4 * o + f) {
+            now = other.now;
+          } else {
+            open_faces |= 1u << f;
+          }
         } else {
-          open.push_back(s);
+          const int* local = kTetFace[f];
+          if (changed_node[after.T(u, local[0])] || changed_node[after.T(u, local[1])] ||
+              changed_node[after.T(u, local[2])]) {
+            open_faces |= 1u << f;
+          }
         }
-      } else {
-        const int* local = kTetFace[f];
-        if (changed_node[after.T(u, local[0])] || changed_node[after.T(u, local[1])] ||
-            changed_node[after.T(u, local[2])]) {
-          open.push_back(s);
-        }
+        row[f] = now;
       }
     }
+    for (int f = 0; open_faces != 0; ++f, open_faces >>= 1)
+      if (open_faces & 1u) open.push_back(4 * u + f);
   }
   struct Entry {
     int a, b, c, slot;
