@@ -121,6 +121,20 @@ void springForces(const Model& m, const NodeVectors& x, const NodeVectors& v, St
 // the positions before the substep) and its own rows, so updating node by node is the same as
 // summing every force first. The AVX2 version sums the rows (x, y, z, 0) in one register, the
 // same additions in the same order.
+// Node row c's force, then v = (v + hm f) * drag and x += h v.
+[[gnu::always_inline]] inline void advanceNode(int c, double f0, double f1, double f2, double hm, double h, double drag,
+                                               double* __restrict x, double* __restrict v, double* __restrict f) {
+  f[c] = f0;
+  f[c + 1] = f1;
+  f[c + 2] = f2;
+  v[c] = (v[c] + hm * f0) * drag;
+  v[c + 1] = (v[c + 1] + hm * f1) * drag;
+  v[c + 2] = (v[c + 2] + hm * f2) * drag;
+  x[c] += h * v[c];
+  x[c + 1] += h * v[c + 1];
+  x[c + 2] += h * v[c + 2];
+}
+
 #define HYSIM_UPDATE_ARGS                                                                                        \
   const Model &m, const double *__restrict ext, double h, double drag, const double *__restrict F, double *__restrict x, \
       double *__restrict v, double *__restrict f
@@ -147,17 +161,7 @@ void integrateBaseline(HYSIM_UPDATE_ARGS) {
         f2 += sign * row[2];
       }
     }
-    const double hm = h * im[i];  // fixed nodes: inv_mass 0, so v stays 0
-    const int c = 3 * i;
-    f[c] = f0;
-    f[c + 1] = f1;
-    f[c + 2] = f2;
-    v[c] = (v[c] + hm * f0) * drag;
-    v[c + 1] = (v[c + 1] + hm * f1) * drag;
-    v[c + 2] = (v[c + 2] + hm * f2) * drag;
-    x[c] += h * v[c];
-    x[c + 1] += h * v[c + 1];
-    x[c + 2] += h * v[c + 2];
+    advanceNode(3 * i, f0, f1, f2, h * im[i], h, drag, x, v, f);  // fixed nodes: inv_mass 0, v stays 0
   }
 }
 [[gnu::target("avx2")]] void integrateAvx2(HYSIM_UPDATE_ARGS) {
@@ -180,17 +184,7 @@ void integrateBaseline(HYSIM_UPDATE_ARGS) {
       }
     }
     _mm256_store_pd(sum, acc);
-    const double hm = h * im[i];
-    const int c = 3 * i;
-    f[c] = sum[0];
-    f[c + 1] = sum[1];
-    f[c + 2] = sum[2];
-    v[c] = (v[c] + hm * sum[0]) * drag;
-    v[c + 1] = (v[c + 1] + hm * sum[1]) * drag;
-    v[c + 2] = (v[c + 2] + hm * sum[2]) * drag;
-    x[c] += h * v[c];
-    x[c + 1] += h * v[c + 1];
-    x[c + 2] += h * v[c + 2];
+    advanceNode(3 * i, sum[0], sum[1], sum[2], h * im[i], h, drag, x, v, f);
   }
 }
 #undef HYSIM_UPDATE_ARGS
