@@ -320,6 +320,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   };
   std::vector<std::int32_t> qSlot(M, -1);
   std::vector<QEntry> qPool;
+  qPool.reserve(M);  // (at most one entry per tet: the pool is never moved as it grows)
   auto tetQ = [&](int t) {
     QEntry cur;
     for (int k = 0; k < 4; ++k) {
@@ -1825,7 +1826,10 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   std::vector<std::int32_t> distSlot;
   std::vector<DistEntry> distPool;
   auto distEntry = [&](int n) -> DistEntry& {
-    if (distSlot.empty()) distSlot.assign(N, -1);
+    if (distSlot.empty()) {
+      distSlot.assign(N, -1);
+      distPool.reserve(N);  // (at most one entry per node: never moved as it grows)
+    }
     std::int32_t& slot = distSlot[n];
     if (slot < 0) {
       slot = static_cast<std::int32_t>(distPool.size());
