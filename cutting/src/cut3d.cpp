@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <limits>
+#include <memory>
 #include <numeric>
 #include <span>
 #include <string>
@@ -1351,10 +1352,10 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
     }
     const int mt = M1 - static_cast<int>(drop.size());
     // tetMap: kept tets in runs between the dropped ones, each shifted down by the number of
-    // dropped tets before it.
-    std::vector<std::int32_t> tetMap(M1);
+    // dropped tets before it. (Every entry is written: no zero fill first.)
+    const auto tetMap = std::make_unique_for_overwrite<std::int32_t[]>(static_cast<size_t>(M1));
     {
-      std::int32_t* m = tetMap.data();
+      std::int32_t* m = tetMap.get();
       int src = 0;
       for (size_t g = 0; g <= drop.size(); ++g) {
         const int end = g < drop.size() ? drop[g] : M1;
@@ -1447,15 +1448,15 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
       }
     }
     std::sort(change.removed_elements.begin(), change.removed_elements.end());
-    auto remapList = [&](std::vector<std::int32_t>& list, const std::vector<std::int32_t>& map) {
+    auto remapList = [&](std::vector<std::int32_t>& list, const std::int32_t* map) {
       std::vector<std::int32_t> kept;
       for (int n : list)
         if (map[n] >= 0) kept.push_back(map[n]);
       list = kept;
     };
-    remapList(change.cut_nodes, nodeMap);
-    remapList(change.moved_nodes, nodeMap);
-    remapList(change.added_elements, tetMap);
+    remapList(change.cut_nodes, nodeMap.data());
+    remapList(change.moved_nodes, nodeMap.data());
+    remapList(change.added_elements, tetMap.get());
     for (auto& nn : change.new_nodes) nn.id = nodeMap[nn.id];
     change.new_nodes.erase(std::remove_if(change.new_nodes.begin(), change.new_nodes.end(),
                                           [](const NewNode& nn) { return nn.id < 0; }),
