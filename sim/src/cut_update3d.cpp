@@ -176,7 +176,8 @@ void lanczosNext(Eigen::Index n, const double* z, double b, double* q, double* c
 }
 
 // Top eigenvalue of M^-1/2 K M^-1/2 (springs linearised along their rest directions) over
-// the free nodes `nodes`, every other node held fixed (a principal submatrix), by Lanczos.
+// the free nodes `nodes` (none anchored), every other node held fixed (a principal
+// submatrix), by Lanczos.
 // `start` (#N x 3, may be null or zero) is mixed into the deterministic start vector; `mode`
 // (#N x 3) receives the Ritz vector (zero outside `nodes`).
 // `decided` (may be null; monotone: once true, true for every larger lambda) may end the
@@ -233,9 +234,9 @@ double topEigenvalue(const Model& m, const cutting::Positions& X, const std::vec
     for (int e = st.node_offset[node]; e < st.node_offset[node + 1]; ++e) {
       const int s = st.incident[e];
       const int a = st.a[s], b = st.b[s];
-      const int other = a == node ? b : a;
-      const int la = m.fixed[a] ? -1 : local[a], lb = m.fixed[b] ? -1 : local[b];
-      if (la >= 0 && lb >= 0 && local[other] < k) continue;  // taken at the other end
+      // (local is -1 at anchored nodes: `nodes` are free ones, the caller's estimate nodes.)
+      const int la = local[a], lb = local[b];
+      if (la >= 0 && lb >= 0 && (a == node ? lb : la) < k) continue;  // taken at the other end
       Eigen::RowVector3d d = X.row(b) - X.row(a);
       d /= d.norm();
       const double sk = std::sqrt(st.stiffness[s]);
@@ -532,8 +533,9 @@ Status prepareModelAfterCut3D(const Model& model, const cutting::TetMesh& before
   CutUpdate3DReport& rep = prepared->report;
   rep.omega_previous = model.omega_max;
 
-  // Material of each tet.
-  std::vector<int> material(static_cast<size_t>(T1), -1);
+  // Material of each tet (written in full below: allocated without a fill).
+  const std::unique_ptr<int[]> material_storage(new int[static_cast<size_t>(T1)]);
+  int* const material = material_storage.get();
   for (int t = 0, last_label = 0, last = -1; t < T1; ++t) {
     if (last < 0 || after.material[t] != last_label) {  // runs of one label: look up at changes
       last_label = after.material[t];
