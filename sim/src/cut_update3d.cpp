@@ -855,6 +855,18 @@ Status finishModelAfterCut3D(Model& model, const cutting::TetMesh& after, const 
     const int j = o2n[i];
     fate[i] = j < 0 || keep[j] < 0 ? -1 : 2 * keep[j] + (touched[j] ? 1 : 0);
   }
+  // The step's springs (those not between two anchored nodes) are counted along, per node
+  // too, for fillStepSprings (buildStepSprings without its counting pass).
+  m.step_springs.node_offset.assign(static_cast<size_t>(N2) + 1, 0);
+  std::int32_t* const step_degree = m.step_springs.node_offset.data();
+  const std::uint8_t* const fixed = m.fixed.data();
+  int step_count = 0;
+  auto countStep = [&](int a, int b) {
+    if (fixed[a] && fixed[b]) return;
+    ++step_count;
+    ++step_degree[a];
+    ++step_degree[b];
+  };
   Eigen::Index out = 0;
   {
     std::int32_t* const sa = m.springs.col(0).data();
@@ -872,6 +884,7 @@ Status finishModelAfterCut3D(Model& model, const cutting::TetMesh& after, const 
       stiffness[out] = stiffness[s];
       damping[out] = damping[s];
       ++out;
+      countStep(a, b);
     }
   }
   Eigen::Index ns = out;
@@ -889,8 +902,9 @@ Status finishModelAfterCut3D(Model& model, const cutting::TetMesh& after, const 
     m.stiffness[out] = sp.k;
     m.damping[out] = sp.c;
     ++out;
+    countStep(keep[sp.a], keep[sp.b]);
   }
-  buildStepSprings(m);
+  fillStepSprings(m, step_count);
   cutting::Positions X(N2, 3);
   for (int i = 0; i < N1; ++i)
     if (keep[i] >= 0) X.row(keep[i]) = after.X.row(i);

@@ -59,12 +59,10 @@ double estimateOmegaMax(const Model& m, const cutting::Positions& X, Eigen::Matr
 }  // namespace
 
 void buildStepSprings(Model& m) {
-  // A spring between two anchored nodes never changes length: the step skips it. Sized by a
-  // counting pass and filled by index (the arrays keep their capacity between calls).
-  const int n = m.num_nodes;
+  // A spring between two anchored nodes never changes length: the step skips it.
   const int ns = static_cast<int>(m.springs.rows());
   StepSprings& st = m.step_springs;
-  st.node_offset.assign(n + 1, 0);
+  st.node_offset.assign(m.num_nodes + 1, 0);
   const std::int32_t* const spring_a = m.springs.col(0).data();
   const std::int32_t* const spring_b = m.springs.col(1).data();
   const std::uint8_t* const fixed = m.fixed.data();
@@ -77,6 +75,18 @@ void buildStepSprings(Model& m) {
     ++off[a];
     ++off[b];
   }
+  fillStepSprings(m, count);
+}
+
+void fillStepSprings(Model& m, int count) {
+  // Sized by the count and filled by index (the arrays keep their capacity between calls).
+  const int n = m.num_nodes;
+  const int ns = static_cast<int>(m.springs.rows());
+  StepSprings& st = m.step_springs;
+  const std::int32_t* const spring_a = m.springs.col(0).data();
+  const std::int32_t* const spring_b = m.springs.col(1).data();
+  const std::uint8_t* const fixed = m.fixed.data();
+  std::int32_t* const off = st.node_offset.data();
   // Each node's number of entries at off[i], summed into the end of its entries; the fill
   // then places each entry just below its node's last one, the springs taken backwards: a
   // node's entries in increasing spring order, off[i] ending at their start (no cursor array).
