@@ -93,7 +93,39 @@ bool lanczosAvx2() {
                                      _mm256_mul_pd(_mm256_loadu_pd(c + 4), _mm256_broadcast_sd(uk + 1)));
     _mm256_storeu_pd(z4 + 4 * k, _mm256_add_pd(xy, _mm256_mul_pd(_mm256_loadu_pd(c + 8), _mm256_broadcast_sd(uk + 2))));
   }
-  for (std::size_t i = 0; i < num_springs; ++i) {
+  // Two springs at a time: their t from u (read only) in one set of shuffles, then their
+  // updates of z in spring order (the same sums in the same order as one at a time).
+  std::size_t i = 0;
+  for (; i + 2 <= num_springs; i += 2) {
+    const FreeSpring4& f1 = springs[i];
+    const FreeSpring4& f2 = springs[i + 1];
+    const __m256d wa1 = _mm256_load_pd(f1.wa), wb1 = _mm256_load_pd(f1.wb);
+    const __m256d wa2 = _mm256_load_pd(f2.wa), wb2 = _mm256_load_pd(f2.wb);
+    const __m256d pa1 = _mm256_mul_pd(wa1, _mm256_loadu_pd(u4 + f1.a));
+    const __m256d pb1 = _mm256_mul_pd(wb1, _mm256_loadu_pd(u4 + f1.b));
+    const __m256d pa2 = _mm256_mul_pd(wa2, _mm256_loadu_pd(u4 + f2.a));
+    const __m256d pb2 = _mm256_mul_pd(wb2, _mm256_loadu_pd(u4 + f2.b));
+    const __m256d lo1 = _mm256_unpacklo_pd(pb1, pa1);  // pb0 pa0 pb2 pa2 (spring 1)
+    const __m256d hi1 = _mm256_unpackhi_pd(pb1, pa1);  // pb1 pa1 pb3 pa3
+    const __m256d lo2 = _mm256_unpacklo_pd(pb2, pa2);
+    const __m256d hi2 = _mm256_unpackhi_pd(pb2, pa2);
+    // ((pb0 + pb1) + pb2, (pa0 + pa1) + pa2) of spring 1 in the low half, of spring 2 in the
+    // high half; then each half's difference
+    const __m256d sums = _mm256_add_pd(
+        _mm256_add_pd(_mm256_permute2f128_pd(lo1, lo2, 0x20), _mm256_permute2f128_pd(hi1, hi2, 0x20)),
+        _mm256_permute2f128_pd(lo1, lo2, 0x31));
+    const __m256d diff = _mm256_hsub_pd(sums, sums);
+    const __m256d t1 = _mm256_permute4x64_pd(diff, 0x00), t2 = _mm256_permute4x64_pd(diff, 0xAA);
+    double* za = z4 + f1.a;
+    double* zb = z4 + f1.b;
+    _mm256_storeu_pd(za, _mm256_sub_pd(_mm256_loadu_pd(za), _mm256_mul_pd(t1, wa1)));
+    _mm256_storeu_pd(zb, _mm256_add_pd(_mm256_loadu_pd(zb), _mm256_mul_pd(t1, wb1)));
+    za = z4 + f2.a;
+    zb = z4 + f2.b;
+    _mm256_storeu_pd(za, _mm256_sub_pd(_mm256_loadu_pd(za), _mm256_mul_pd(t2, wa2)));
+    _mm256_storeu_pd(zb, _mm256_add_pd(_mm256_loadu_pd(zb), _mm256_mul_pd(t2, wb2)));
+  }
+  for (; i < num_springs; ++i) {
     const FreeSpring4& fs = springs[i];
     const __m256d wa = _mm256_load_pd(fs.wa), wb = _mm256_load_pd(fs.wb);
     double* za = z4 + fs.a;
