@@ -600,16 +600,17 @@ Status prepareModelAfterCut3D(const Model& model, const cutting::TetMesh& before
       row[1] = c1[t];
       row[2] = c2[t];
       row[3] = c3[t];
-      for (int k = 0; k < 4; ++k) ++off[row[k] + 1];
+      for (int k = 0; k < 4; ++k) ++off[row[k]];
     }
   }
   auto node = [tv](int t, int k) { return tv[4 * static_cast<size_t>(t) + k]; };
-  for (int i = 0; i < N1; ++i) off[i + 1] += off[i];
-  {
-    std::vector<int> fill(off.begin(), off.end() - 1);
-    for (int t = 0; t < T1; ++t)
-      for (int k = 0; k < 4; ++k) around[fill[node(t, k)]++] = t;
-  }
+  // Each node's number of tets at off[i], summed into the end of its entries; the tets then
+  // taken backwards, each placed just below its node's last one: a node's tets in increasing
+  // order, off[i] ending at their start (no cursor array copied).
+  for (int i = 1; i < N1; ++i) off[i] += off[i - 1];
+  if (N1 > 0) off[N1] = off[N1 - 1];
+  for (int t = T1 - 1; t >= 0; --t)
+    for (int k = 3; k >= 0; --k) around[--off[node(t, k)]] = t;
   std::vector<double> volume(static_cast<size_t>(T1), std::nan(""));
   auto tetVolume = [&](int t) {
     if (std::isnan(volume[t])) {  // cutting::tetVolume's arithmetic, inlined
