@@ -789,6 +789,9 @@ Status prepareModelAfterCut3D(const Model& model, const cutting::TetMesh& before
   };
   std::vector<EdgeSum> edge_sums;
   std::vector<int> slot(static_cast<size_t>(N1), -1);
+  // About 7 edges a node towards higher-numbered neighbours in a tet mesh: room for most
+  // cuts without regrowing (each regrowth copies the springs collected so far).
+  springs.reserve(8 * static_cast<size_t>(rep.touched_nodes));
   int recomputed = 0;
   for (int r = 0; r < rep.touched_nodes; ++r) {
     const int a = region_nodes[r];
