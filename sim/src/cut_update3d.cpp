@@ -93,7 +93,39 @@ bool lanczosAvx2() {
                                      _mm256_mul_pd(_mm256_loadu_pd(c + 4), _mm256_broadcast_sd(uk + 1)));
     _mm256_storeu_pd(z4 + 4 * k, _mm256_add_pd(xy, _mm256_mul_pd(_mm256_loadu_pd(c + 8), _mm256_broadcast_sd(uk + 2))));
   }
-  for (std::size_t i = 0; i < num_springs; ++i) {
+  // Two springs at a time: their t from u (read only) in one set of shuffles, then their
+  // updates of z in spring order (the same sums in the same order as one at a time).
+  std::size_t i = 0;
+  for (; i + 2 <= num_springs; i += 2) {
+    const FreeSpring4& f1 = springs[i];
+    const FreeSpring4& f2 = springs[i + 1];
+    const __m256d wa1 = _mm256_load_pd(f1.wa), wb1 = _mm256_load_pd(f1.wb);
+    const __m256d wa2 = _mm256_load_pd(f2.wa), wb2 = _mm256_load_pd(f2.wb);
+    const __m256d pa1 = _mm256_mul_pd(wa1, _mm256_loadu_pd(u4 + f1.a));
+    const __m256d pb1 = _mm256_mul_pd(wb1, _mm256_loadu_pd(u4 + f1.b));
+    const __m256d pa2 = _mm256_mul_pd(wa2, _mm256_loadu_pd(u4 + f2.a));
+    const __m256d pb2 = _mm256_mul_pd(wb2, _mm256_loadu_pd(u4 + f2.b));
+    const __m256d lo1 = _mm256_unpacklo_pd(pb1, pa1);  // pb0 pa0 pb2 pa2 (spring 1)
+    const __m256d hi1 = _mm256_unpackhi_pd(pb1, pa1);  // pb1 pa1 pb3 pa3
+    const __m256d lo2 = _mm256_unpacklo_pd(pb2, pa2);
+    const __m256d hi2 = _mm256_unpackhi_pd(pb2, pa2);
+    // ((pb0 + pb1) + pb2, (pa0 + pa1) + pa2) of spring 1 in the low half, of spring 2 in the
+    // high half; then each half's difference
+    const __m256d sums = _mm256_add_pd(
+        _mm256_add_pd(_mm256_permute2f128_pd(lo1, lo2, 0x20), _mm256_permute2f128_pd(hi1, hi2, 0x20)),
+        _mm256_permute2f128_pd(lo1, lo2, 0x31));
+    const __m256d diff = _mm256_hsub_pd(sums, sums);
+    const __m256d t1 = _mm256_permute4x64_pd(diff, 0x00), t2 = _mm256_permute4x64_pd(diff, 0xAA);
+    double* za = z4 + f1.a;
+    double* zb = z4 + f1.b;
+    _mm256_storeu_pd(za, _mm256_sub_pd(_mm256_loadu_pd(za), _mm256_mul_pd(t1, wa1)));
+    _mm256_storeu_pd(zb, _mm256_add_pd(_mm256_loadu_pd(zb), _mm256_mul_pd(t1, wb1)));
+    za = z4 + f2.a;
+    zb = z4 + f2.b;
+    _mm256_storeu_pd(za, _mm256_sub_pd(_mm256_loadu_pd(za), _mm256_mul_pd(t2, wa2)));
+    _mm256_storeu_pd(zb, _mm256_add_pd(_mm256_loadu_pd(zb), _mm256_mul_pd(t2, wb2)));
+  }
+  for (; i < num_springs; ++i) {
     const FreeSpring4& fs = springs[i];
     const __m256d wa = _mm256_load_pd(fs.wa), wb = _mm256_load_pd(fs.wb);
     double* za = z4 + fs.a;
@@ -176,7 +208,8 @@ void lanczosNext(Eigen::Index n, const double* z, double b, double* q, double* c
 }
 
 // Top eigenvalue of M^-1/2 K M^-1/2 (springs linearised along their rest directions) over
-// the free nodes `nodes`, every other node held fixed (a principal submatrix), by Lanczos.
+// the free nodes `nodes` (none anchored), every other node held fixed (a principal
+// submatrix), by Lanczos.
 // `start` (#N x 3, may be null or zero) is mixed into the deterministic start vector; `mode`
 // (#N x 3) receives the Ritz vector (zero outside `nodes`).
 // `decided` (may be null; monotone: once true, true for every larger lambda) may end the
@@ -233,9 +266,9 @@ double topEigenvalue(const Model& m, const cutting::Positions& X, const std::vec
     for (int e = st.node_offset[node]; e < st.node_offset[node + 1]; ++e) {
       const int s = st.incident[e];
       const int a = st.a[s], b = st.b[s];
-      const int other = a == node ? b : a;
-      const int la = m.fixed[a] ? -1 : local[a], lb = m.fixed[b] ? -1 : local[b];
-      if (la >= 0 && lb >= 0 && local[other] < k) continue;  // taken at the other end
+      // (local is -1 at anchored nodes: `nodes` are free ones, the caller's estimate nodes.)
+      const int la = local[a], lb = local[b];
+      if (la >= 0 && lb >= 0 && (a == node ? lb : la) < k) continue;  // taken at the other end
       Eigen::RowVector3d d = X.row(b) - X.row(a);
       d /= d.norm();
       const double sk = std::sqrt(st.stiffness[s]);
@@ -532,8 +565,9 @@ Status prepareModelAfterCut3D(const Model& model, const cutting::TetMesh& before
   CutUpdate3DReport& rep = prepared->report;
   rep.omega_previous = model.omega_max;
 
-  // Material of each tet.
-  std::vector<int> material(static_cast<size_t>(T1), -1);
+  // Material of each tet (written in full below: allocated without a fill).
+  const std::unique_ptr<int[]> material_storage(new int[static_cast<size_t>(T1)]);
+  int* const material = material_storage.get();
   for (int t = 0, last_label = 0, last = -1; t < T1; ++t) {
     if (last < 0 || after.material[t] != last_label) {  // runs of one label: look up at changes
       last_label = after.material[t];
@@ -566,16 +600,17 @@ Status prepareModelAfterCut3D(const Model& model, const cutting::TetMesh& before
       row[1] = c1[t];
       row[2] = c2[t];
       row[3] = c3[t];
-      for (int k = 0; k < 4; ++k) ++off[row[k] + 1];
+      for (int k = 0; k < 4; ++k) ++off[row[k]];
     }
   }
   auto node = [tv](int t, int k) { return tv[4 * static_cast<size_t>(t) + k]; };
-  for (int i = 0; i < N1; ++i) off[i + 1] += off[i];
-  {
-    std::vector<int> fill(off.begin(), off.end() - 1);
-    for (int t = 0; t < T1; ++t)
-      for (int k = 0; k < 4; ++k) around[fill[node(t, k)]++] = t;
-  }
+  // Each node's number of tets at off[i], summed into the end of its entries; the tets then
+  // taken backwards, each placed just below its node's last one: a node's tets in increasing
+  // order, off[i] ending at their start (no cursor array copied).
+  for (int i = 1; i < N1; ++i) off[i] += off[i - 1];
+  if (N1 > 0) off[N1] = off[N1 - 1];
+  for (int t = T1 - 1; t >= 0; --t)
+    for (int k = 3; k >= 0; --k) around[--off[node(t, k)]] = t;
   std::vector<double> volume(static_cast<size_t>(T1), std::nan(""));
   auto tetVolume = [&](int t) {
     if (std::isnan(volume[t])) {  // cutting::tetVolume's arithmetic, inlined
@@ -754,6 +789,9 @@ Status prepareModelAfterCut3D(const Model& model, const cutting::TetMesh& before
   };
   std::vector<EdgeSum> edge_sums;
   std::vector<int> slot(static_cast<size_t>(N1), -1);
+  // About 7 edges a node towards higher-numbered neighbours in a tet mesh: room for most
+  // cuts without regrowing (each regrowth copies the springs collected so far).
+  springs.reserve(8 * static_cast<size_t>(rep.touched_nodes));
   int recomputed = 0;
   for (int r = 0; r < rep.touched_nodes; ++r) {
     const int a = region_nodes[r];
@@ -853,6 +891,18 @@ Status finishModelAfterCut3D(Model& model, const cutting::TetMesh& after, const 
     const int j = o2n[i];
     fate[i] = j < 0 || keep[j] < 0 ? -1 : 2 * keep[j] + (touched[j] ? 1 : 0);
   }
+  // The step's springs (those not between two anchored nodes) are counted along, per node
+  // too, for fillStepSprings (buildStepSprings without its counting pass).
+  m.step_springs.node_offset.assign(static_cast<size_t>(N2) + 1, 0);
+  std::int32_t* const step_degree = m.step_springs.node_offset.data();
+  const std::uint8_t* const fixed = m.fixed.data();
+  int step_count = 0;
+  auto countStep = [&](int a, int b) {
+    if (fixed[a] && fixed[b]) return;
+    ++step_count;
+    ++step_degree[a];
+    ++step_degree[b];
+  };
   Eigen::Index out = 0;
   {
     std::int32_t* const sa = m.springs.col(0).data();
@@ -870,6 +920,7 @@ Status finishModelAfterCut3D(Model& model, const cutting::TetMesh& after, const 
       stiffness[out] = stiffness[s];
       damping[out] = damping[s];
       ++out;
+      countStep(a, b);
     }
   }
   Eigen::Index ns = out;
@@ -887,8 +938,9 @@ Status finishModelAfterCut3D(Model& model, const cutting::TetMesh& after, const 
     m.stiffness[out] = sp.k;
     m.damping[out] = sp.c;
     ++out;
+    countStep(keep[sp.a], keep[sp.b]);
   }
-  buildStepSprings(m);
+  fillStepSprings(m, step_count);
   cutting::Positions X(N2, 3);
   for (int i = 0; i < N1; ++i)
     if (keep[i] >= 0) X.row(keep[i]) = after.X.row(i);

@@ -59,50 +59,68 @@ double estimateOmegaMax(const Model& m, const cutting::Positions& X, Eigen::Matr
 }  // namespace
 
 void buildStepSprings(Model& m) {
-  // A spring between two anchored nodes never changes length: the step skips it. Sized by a
-  // counting pass and filled by index (the arrays keep their capacity between calls).
+  // A spring between two anchored nodes never changes length: the step skips it.
+  const int ns = static_cast<int>(m.springs.rows());
+  StepSprings& st = m.step_springs;
+  st.node_offset.assign(m.num_nodes + 1, 0);
+  const std::int32_t* const spring_a = m.springs.col(0).data();
+  const std::int32_t* const spring_b = m.springs.col(1).data();
+  const std::uint8_t* const fixed = m.fixed.data();
+  std::int32_t* const off = st.node_offset.data();
+  int count = 0;
+  for (int s = 0; s < ns; ++s) {
+    const int a = spring_a[s], b = spring_b[s];
+    if (fixed[a] && fixed[b]) continue;
+    ++count;
+    ++off[a];
+    ++off[b];
+  }
+  fillStepSprings(m, count);
+}
+
+void fillStepSprings(Model& m, int count) {
+  // Sized by the count and filled by index (the arrays keep their capacity between calls).
   const int n = m.num_nodes;
   const int ns = static_cast<int>(m.springs.rows());
   StepSprings& st = m.step_springs;
-  st.node_offset.assign(n + 1, 0);
-  int count = 0;
-  for (int s = 0; s < ns; ++s) {
-    const int a = m.springs(s, 0), b = m.springs(s, 1);
-    if (m.fixed[a] && m.fixed[b]) continue;
-    ++count;
-    ++st.node_offset[a + 1];
-    ++st.node_offset[b + 1];
-  }
-  // One pass: each step spring's arrays and its two incidence entries (node_offset's prefix
-  // sums first; a node's entries in increasing spring order, as a pass over the filled arrays).
+  const std::int32_t* const spring_a = m.springs.col(0).data();
+  const std::int32_t* const spring_b = m.springs.col(1).data();
+  const std::uint8_t* const fixed = m.fixed.data();
+  std::int32_t* const off = st.node_offset.data();
+  // Each node's number of entries at off[i], summed into the end of its entries; the fill
+  // then places each entry just below its node's last one, the springs taken backwards: a
+  // node's entries in increasing spring order, off[i] ending at their start (no cursor array).
+  for (int i = 1; i < n; ++i) off[i] += off[i - 1];
+  if (n > 0) off[n] = off[n - 1];
   st.a.resize(count);
   st.b.resize(count);
   st.rest_length.resize(count);
   st.stiffness.resize(count);
   st.damping.resize(count);
-  for (int i = 0; i < n; ++i) st.node_offset[i + 1] += st.node_offset[i];
-  st.incident.resize(st.node_offset[n]);
-  st.sign.resize(st.node_offset[n]);
-  std::vector<int> fill(st.node_offset.begin(), st.node_offset.end() - 1);
-  const std::int32_t* const spring_a = m.springs.col(0).data();
-  const std::int32_t* const spring_b = m.springs.col(1).data();
-  const std::uint8_t* const fixed = m.fixed.data();
+  st.incident.resize(off[n]);
+  st.sign.resize(off[n]);
+  std::int32_t* const step_a = st.a.data();
+  std::int32_t* const step_b = st.b.data();
+  double* const rest = st.rest_length.data();
+  double* const stiffness = st.stiffness.data();
+  double* const damping = st.damping.data();
   std::int32_t* const incident = st.incident.data();
   double* const sign = st.sign.data();
-  int* const next = fill.data();
-  for (int s = 0, k = 0; s < ns; ++s) {
+  for (int s = ns - 1, k = count - 1; s >= 0; --s) {
     const int a = spring_a[s], b = spring_b[s];
     if (fixed[a] && fixed[b]) continue;
-    st.a[k] = a;
-    st.b[k] = b;
-    st.rest_length[k] = m.rest_length[s];
-    st.stiffness[k] = m.stiffness[s];
-    st.damping[k] = m.damping[s];
-    incident[next[a]] = k;
-    sign[next[a]++] = 1.0;
-    incident[next[b]] = k;
-    sign[next[b]++] = -1.0;
-    ++k;
+    step_a[k] = a;
+    step_b[k] = b;
+    rest[k] = m.rest_length[s];
+    stiffness[k] = m.stiffness[s];
+    damping[k] = m.damping[s];
+    const int ea = --off[a];
+    incident[ea] = k;
+    sign[ea] = 1.0;
+    const int eb = --off[b];
+    incident[eb] = k;
+    sign[eb] = -1.0;
+    --k;
   }
 }
 

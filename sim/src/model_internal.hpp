@@ -11,6 +11,9 @@ namespace hysim::sim {
 
 // Model::step_springs from the spring arrays, fixed flags and num_nodes (O(#S + #N)).
 void buildStepSprings(Model& model);
+// Its second part: node_offset sized #N+1 and holding at [i] node i's number of step springs
+// (at [#N] 0), `count` the number of step springs.
+void fillStepSprings(Model& model, int count);
 
 // The largest eigenvalue of the symmetric tridiagonal matrix with diagonal `diag` and
 // subdiagonal `sub` (size diag.size() - 1), to a few units in the last place of the matrix's
