@@ -470,6 +470,37 @@ double CutSurface::signedDistance(const Eigen::Vector3d& x, Eigen::Vector3d* clo
   return signedDistanceNear(x, std::numeric_limits<double>::infinity(), closest);
 }
 
+// The stack holds each node with its box distance (computed when its parent pushed it: the
+// same value as computing it again when popped).
+// (The walk is that of pushing the root, then popping a node, skipping it when its distance
+// is above the bound, else testing a leaf's triangles or pushing an inner node's children
+// within the bound, the nearer last; the nearer child, popped at once, is visited without the
+// stack.)
+template <class Leaf>
+void CutSurface::walkNear(const Eigen::Vector3d& x, const double* xx, const double& bound, Leaf&& leaf) const {
+  int stack[128];
+  double stackDist[128];
+  int top = 0;
+  int id = boxDistance2(nodes_[0].box, x) > bound ? -1 : 0;
+  for (;;) {
+    if (id < 0) {
+      if (top == 0) break;
+      --top;
+      if (stackDist[top] > bound) continue;  // (equal: a tie with a lower index may be there)
+      id = stack[top];
+    }
+    const Node& node = nodes_[id];
+    if (node.left < 0) {
+      if (leaf(node.begin, node.end)) return;
+      id = -1;
+    } else if (top + 2 <= 128) {
+      id = stepChildren(id, xx, bound, stack, stackDist, top);
+    } else {
+      id = -1;
+    }
+  }
+}
+
 double CutSurface::signedDistanceNear(const Eigen::Vector3d& x, double r, Eigen::Vector3d* closest) const {
   if (is_plane_) {
     const double d = normal_.dot(x - point_);
@@ -483,44 +514,21 @@ double CutSurface::signedDistanceNear(const Eigen::Vector3d& x, double r, Eigen:
                                  : std::numeric_limits<double>::infinity();
   int bestTri = -1, bestLeaf = -1;  // input index (for ties), place in leafTri_
   Eigen::Vector3d bestPoint = x;
-  // The stack holds each node with its box distance (computed when its parent pushed it: the
-  // same value as computing it again when popped).
-  // (The walk is that of pushing the root, then popping a node, skipping it when its distance
-  // is above best, else testing a leaf's triangles or pushing an inner node's children within
-  // best, the nearer last; the nearer child, popped at once, is visited without the stack.)
-  int stack[128];
-  double stackDist[128];
-  int top = 0;
   alignas(16) const double xx[6] = {x[0], x[0], x[1], x[1], x[2], x[2]};
-  int id = boxDistance2(nodes_[0].box, x) > best ? -1 : 0;
-  for (;;) {
-    if (id < 0) {
-      if (top == 0) break;
-      --top;
-      if (stackDist[top] > best) continue;  // (equal: a tie with a lower index may be there)
-      id = stack[top];
-    }
-    const Node& node = nodes_[id];
-    if (node.left < 0) {
-      id = -1;
-      for (int i = node.begin; i < node.end; ++i) {
-        const Eigen::Vector3d q = nearestOnLeaf(xx, x, i);
-        const double d2 = (q - x).squaredNorm();
-        // (Ties: the lower triangle index, whatever the order of the walk.)
-        if (d2 < best || (d2 == best && order_[i] < bestTri)) {
-          best = d2;
-          bestTri = order_[i];
-          bestLeaf = i;
-          bestPoint = q;
-        }
+  walkNear(x, xx, best, [&](int begin, int end) {
+    for (int i = begin; i < end; ++i) {
+      const Eigen::Vector3d q = nearestOnLeaf(xx, x, i);
+      const double d2 = (q - x).squaredNorm();
+      // (Ties: the lower triangle index, whatever the order of the walk.)
+      if (d2 < best || (d2 == best && order_[i] < bestTri)) {
+        best = d2;
+        bestTri = order_[i];
+        bestLeaf = i;
+        bestPoint = q;
       }
-    } else if (top + 2 <= 128) {
-      // The nearer child first: a close triangle found early prunes the rest.
-      id = stepChildren(id, xx, best, stack, stackDist, top);
-    } else {
-      id = -1;
     }
-  }
+    return false;
+  });
   if (bestTri < 0 && std::isfinite(r)) return signedDistanceNear(x, std::numeric_limits<double>::infinity(), closest);
   if (closest) *closest = bestPoint;
   if (bestTri < 0) return std::numeric_limits<double>::infinity();
@@ -665,33 +673,13 @@ bool CutSurface::within(const Eigen::Vector3d& x, double r) const {
   if (is_plane_) return std::abs(normal_.dot(x - point_)) <= r;
   // Boxes farther than r (with a margin for rounding) cannot hold a triangle within r.
   const double limit = r * r * (1.0 + 1e-6) + std::numeric_limits<double>::min();
-  int stack[128];
-  double stackDist[128];  // (as in signedDistanceNear)
-  int top = 0;
   alignas(16) const double xx[6] = {x[0], x[0], x[1], x[1], x[2], x[2]};
-  int id = boxDistance2(nodes_[0].box, x) > limit ? -1 : 0;
-  for (;;) {
-    if (id < 0) {
-      if (top == 0) break;
-      --top;
-      if (stackDist[top] > limit) continue;
-      id = stack[top];
-    }
-    const Node& node = nodes_[id];
-    if (node.left < 0) {
-      id = -1;
-      for (int i = node.begin; i < node.end; ++i) {
-        const Eigen::Vector3d q = nearestOnLeaf(xx, x, i);
-        if (std::sqrt((q - x).squaredNorm()) <= r) return true;
-      }
-    } else if (top + 2 <= 128) {
-      // The nearer child first: a hit there ends the walk sooner.
-      id = stepChildren(id, xx, limit, stack, stackDist, top);
-    } else {
-      id = -1;
-    }
-  }
-  return false;
+  bool found = false;
+  walkNear(x, xx, limit, [&](int begin, int end) {
+    for (int i = begin; i < end && !found; ++i) found = std::sqrt((nearestOnLeaf(xx, x, i) - x).squaredNorm()) <= r;
+    return found;
+  });
+  return found;
 }
 
 }  // namespace hysim::cutting

@@ -124,6 +124,11 @@ class CutSurface {
   // One step of a nearest-point walk at inner node `id` (see there); xx: the point's
   // coordinates, each twice (x0 x0 x1 x1 x2 x2, 16-byte aligned).
   int stepChildren(int id, const double* xx, double limit, int* stack, double* stackDist, int& top) const;
+  // The nearest-point walk (signedDistanceNear, within): nodes whose boxes are within `bound`
+  // of the point (read again at each step: a leaf may lower it), the nearer child first;
+  // leaf(begin, end) tests a leaf's triangles and returns true to end the walk.
+  template <class Leaf>
+  void walkNear(const Eigen::Vector3d& x, const double* xx, const double& bound, Leaf&& leaf) const;
   // Which of inner node `id`'s children's boxes meet the box [lo, hi] (bit 0 left, bit 1 right);
   // lohi: lo's coordinates, then hi's, each twice (16-byte aligned).
   int childrenMeet(int id, const double* lohi) const;
