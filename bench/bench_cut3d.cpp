@@ -342,12 +342,29 @@ void BM_Cut3DReplay(benchmark::State& state) {
     state.SkipWithError("HYSIM_REPLAY_DIR unset or without pass_001_mesh.msh / pass_001_surface.msh");
     return;
   }
-  const hysim::cutting::Cut3DOptions o;
+  // Arg 1: the pieces cut off are left as cut (Cut3DOptions::anchored_nodes, chips.optimize
+  // false in a scene), with the default scene's anchors (outside its ellipsoid: the corpus is
+  // the default run's).
+  const bool leaveChips = state.range(0) == 1;
+  hysim::cutting::Cut3DOptions o;
+  auto outside = [](const Eigen::Vector3d& p) {
+    const double x = p[0] / 25, y = p[1] / 20, z = p[2] / 33;
+    return x * x + y * y + z * z > 1;
+  };
+  if (leaveChips) o.anchored_at = outside;
   std::vector<double> cutMs, optMs;
-  double qSum = 0;
+  double qSum = 0, qKept = 0;
+  int cutOff = 0;
   for (auto _ : state) {
     qSum = 0;
+    qKept = 0;
+    cutOff = 0;
     for (const auto& p : passes) {
+      state.PauseTiming();
+      std::vector<std::uint8_t> anchored(static_cast<size_t>(p.mesh.numNodes()));
+      for (int i = 0; i < p.mesh.numNodes(); ++i) anchored[i] = outside(p.mesh.X.row(i).transpose()) ? 1 : 0;
+      if (leaveChips) o.anchored_nodes = &anchored;
+      state.ResumeTiming();
       const auto t0 = std::chrono::steady_clock::now();
       auto r = hysim::cutting::cut3d(p.mesh, p.surface, o);
       const auto t1 = std::chrono::steady_clock::now();
@@ -359,6 +376,20 @@ void BM_Cut3DReplay(benchmark::State& state) {
       optMs.push_back(r->report.optimize_ms);
       state.PauseTiming();
       qSum += hysim::cutting::computeStats(r->mesh).q_min;
+      {  // q*_min of the anchored pieces (what the simulator keeps)
+        const hysim::cutting::TetMesh& m = r->mesh;
+        std::vector<int> anchors;
+        for (int i = 0; i < m.numNodes(); ++i)
+          if (outside(m.X.row(i).transpose())) anchors.push_back(i);
+        const auto c = hysim::cutting::tetComponents(m, anchors);
+        double q = 1;
+        for (int t = 0; t < m.numTets(); ++t)
+          if (!c.free[c.label[t]])
+            q = std::min(q, hysim::cutting::radiusRatio(m.X.row(m.T(t, 0)).transpose(), m.X.row(m.T(t, 1)).transpose(),
+                                                        m.X.row(m.T(t, 2)).transpose(), m.X.row(m.T(t, 3)).transpose()));
+        qKept += q;
+        cutOff += r->report.cut_off_elements;
+      }
       state.ResumeTiming();
       benchmark::DoNotOptimize(r);
     }
@@ -373,8 +404,10 @@ void BM_Cut3DReplay(benchmark::State& state) {
   state.counters["optimize_ms_max"] = optMs.empty() ? 0.0 : *std::max_element(optMs.begin(), optMs.end());
   state.counters["passes"] = static_cast<double>(passes.size());
   state.counters["q_min_sum"] = qSum;
+  state.counters["q_kept_sum"] = qKept;
+  state.counters["cut_off"] = cutOff;
 }
-BENCHMARK(BM_Cut3DReplay)->Unit(benchmark::kMillisecond)->Iterations(3)->Repetitions(1);
+BENCHMARK(BM_Cut3DReplay)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->Iterations(3)->Repetitions(1);
 
 // Building the recorded passes' cut surfaces (the last part of the pass's map_ms): arg 0 =
 // CutSurface::strip (the simulator's, a tree along the grid), 1 = CutSurface::triangles of

@@ -241,6 +241,118 @@ int findLocal(const Tet& t, int v) {
   return -1;
 }
 
+// The pieces the cut cut off (see Cut3DOptions::anchored_nodes): node-connected parts of
+// `mesh` (through the tets in each node's list) with no anchored node. A search from the
+// seeds (the nodes on and around the cut), one front per part found, the open fronts in turn
+// a node at a time; fronts that meet merge. A front that reaches an anchored node holds its
+// part in place; one that runs out of nodes has seen all of a free part. The search stops
+// when every front is decided, when one front is open and none held a part yet (that part
+// holds the tissue, unless nothing does: it is not looked into and not marked), or after
+// `limit` nodes in all (then no open part is marked). Marks the tets of the
+// free parts in *tets (#T) and their nodes in *nodes (#N); returns the number of parts.
+int cutOffPieces(const TetMesh& mesh, const StarLists& stars, const std::vector<std::int32_t>& seeds,
+                 const std::function<bool(int)>& anchored, int limit, std::vector<std::uint8_t>* tets,
+                 std::vector<std::uint8_t>* nodes) {
+  const int N = mesh.numNodes();
+  auto starOf = [&](int n) {
+    const std::int32_t* b = stars.pool_start[n] >= 0 ? stars.pool.data() + stars.pool_start[n] : stars.star.data() + stars.off[n];
+    const std::int32_t len = stars.pool_start[n] >= 0 ? stars.pool_len[n] : stars.off[n + 1] - stars.off[n];
+    return std::make_pair(b, b + len);
+  };
+  enum : std::uint8_t { Open, Held, Free };
+  struct Front {
+    std::vector<std::int32_t> queue;
+    size_t head = 0;
+    std::int32_t parent;
+    std::uint8_t state = Open;
+  };
+  std::vector<Front> fronts;
+  std::vector<std::int32_t> owner(N, -1);
+  auto root = [&](int f) {
+    while (fronts[f].parent != f) f = fronts[f].parent = fronts[fronts[f].parent].parent;
+    return f;
+  };
+  int open = 0, held = 0, seen = 0;
+  // Node v joins front f (a root); false when that holds f's part in place.
+  auto join = [&](int v, int f) {
+    owner[v] = f;
+    ++seen;
+    if (!anchored(v)) {
+      fronts[f].queue.push_back(v);
+      return true;
+    }
+    fronts[f].state = Held;
+    fronts[f].queue.clear();
+    --open;
+    ++held;
+    return false;
+  };
+  for (const int s : seeds) {
+    if (s < 0 || s >= N || owner[s] >= 0) continue;
+    const int f = static_cast<int>(fronts.size());
+    fronts.emplace_back();
+    fronts[f].parent = f;
+    ++open;
+    join(s, f);
+  }
+  std::vector<std::int32_t> turn(fronts.size());
+  std::iota(turn.begin(), turn.end(), 0);
+  auto searching = [&] { return open > (held > 0 ? 0 : 1) && seen <= limit; };
+  while (searching()) {
+    size_t kept = 0;
+    for (const int f0 : turn) {
+      if (!searching()) break;
+      if (fronts[f0].parent != f0 || fronts[f0].state != Open) continue;
+      Front& front = fronts[f0];
+      if (front.head == front.queue.size()) {  // all of its part seen
+        front.state = Free;
+        --open;
+        continue;
+      }
+      const int u = front.queue[front.head++];
+      const auto [b, e] = starOf(u);
+      for (const std::int32_t* t = b; t < e && fronts[f0].state == Open; ++t)
+        for (int k = 0; k < 4; ++k) {
+          const int v = mesh.T(*t, k);
+          if (owner[v] < 0) {
+            if (!join(v, f0)) break;
+            continue;
+          }
+          const int g = root(owner[v]);
+          if (g == f0) continue;
+          // Two fronts of one part: g goes into f0 (f0 keeps its turn).
+          Front& other = fronts[g];
+          other.parent = f0;
+          if (other.state == Held) {
+            fronts[f0].state = Held;
+            fronts[f0].queue.clear();
+            --open;
+            ++held;
+            break;
+          }
+          --open;  // (other was open: a free front has no node next to an unseen one)
+          fronts[f0].queue.insert(fronts[f0].queue.end(), other.queue.begin() + static_cast<std::ptrdiff_t>(other.head),
+                                  other.queue.end());
+          other.queue.clear();
+        }
+      if (fronts[f0].parent == f0 && fronts[f0].state == Open) turn[kept++] = f0;
+    }
+    turn.resize(kept);
+  }
+  int pieces = 0;
+  for (size_t f = 0; f < fronts.size(); ++f) pieces += fronts[f].parent == static_cast<int>(f) && fronts[f].state == Free;
+  if (pieces == 0) return 0;
+  tets->assign(static_cast<size_t>(mesh.numTets()), 0);
+  nodes->assign(static_cast<size_t>(N), 0);
+  for (int v = 0; v < N; ++v) {
+    if (owner[v] < 0 || fronts[root(owner[v])].state != Free) continue;
+    (*nodes)[v] = 1;
+    const auto [b, e] = starOf(v);
+    for (const std::int32_t* t = b; t < e; ++t) (*tets)[*t] = 1;
+  }
+  return pieces;
+}
+
 }  // namespace
 
 void buildStarLists(const Tets& T, int numNodes, StarLists* lists) {
@@ -1309,9 +1421,34 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
     }
 #endif
     region.stars = &stars;
+    // The pieces cut off (options.anchored_nodes) are left as they are: no seeds there, and
+    // their tets are dead to the optimisation (unmarked in `peeled` after it).
+    std::vector<std::uint8_t> cutOffTets, cutOffNodes;
+    if (options.anchored_nodes != nullptr) {
+      IndexBits repositioned(N1);  // nodes the cut made, moved or put on the cut: anchored_at
+      for (const int n : moved) repositioned.mark(n);
+      for (const int n : cutNodes) repositioned.mark(n);
+      const std::vector<std::uint8_t>& flags = *options.anchored_nodes;
+      const std::function<bool(int)> anchored = [&](int n) {
+        if (n >= N0 || repositioned.has(n))
+          return options.anchored_at ? options.anchored_at(out.X.row(n).transpose()) : false;
+        return n < static_cast<int>(flags.size()) && flags[n] != 0;
+      };
+      report.cut_off_pieces = cutOffPieces(out, stars, region.seeds, anchored, options.free_piece_search_limit,
+                                           &cutOffTets, &cutOffNodes);
+      if (report.cut_off_pieces > 0) {
+        region.seeds.erase(std::remove_if(region.seeds.begin(), region.seeds.end(), [&](int n) { return cutOffNodes[n] != 0; }),
+                           region.seeds.end());
+        region.left_alone = &cutOffTets;
+        for (const std::uint8_t f : cutOffTets) report.cut_off_elements += f;
+      }
+    }
     const size_t before = moved.size();
     OptimizeCounts counts;
     optimizeAroundCut(out, region, options.optimize, &moved, &peeled, &counts);
+    if (region.left_alone != nullptr)
+      for (size_t t = 0; t < cutOffTets.size(); ++t)
+        if (cutOffTets[t]) peeled[t] = 0;
     report.optimize_iterations = counts.iterations;
     report.peeled_elements = counts.peeled;
     report.flap_peeled = counts.flap_peeled;

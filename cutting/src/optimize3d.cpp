@@ -117,7 +117,11 @@ struct Constraint {
 void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DOptions& options,
                        std::vector<std::int32_t>* moved, std::vector<std::uint8_t>* dead, OptimizeCounts* counts) {
   const int N = mesh.numNodes(), M = mesh.numTets();
-  dead->assign(M, 0);
+  if (region.left_alone != nullptr && region.left_alone->size() == static_cast<size_t>(M)) {
+    *dead = *region.left_alone;
+  } else {
+    dead->assign(M, 0);
+  }
   if (region.seeds.empty() || N == 0) return;
   const bool plane = region.surface && region.surface->isPlane();
   // The repairs for curved cut surfaces (shaving): curved boundaries and ridges move, slivers

@@ -91,6 +91,9 @@ struct CutRegion {
   // Optional: the output mesh's node -> tet lists (cut3d: the input's, patched where the cut
   // changed tets), which optimizeAroundCut takes over (moved from) instead of building them.
   StarLists* stars = nullptr;
+  // Optional (#T): tets left as they are (pieces the cut cut off), as if already removed:
+  // no operation reads or changes them. They start marked in *dead (the caller unmarks them).
+  const std::vector<std::uint8_t>* left_alone = nullptr;
 };
 
 struct OptimizeCounts {

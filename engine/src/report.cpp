@@ -166,6 +166,7 @@ std::string reportJson(const RunReport& r) {
     e["snapped_nodes"] = p.snapped_nodes;
     e["split_edges"] = p.split_edges;
     e["duplicated_nodes"] = p.duplicated_nodes;
+    e["unoptimised_chip_elements"] = p.unoptimised_chip_elements;
     e["cut_faces"] = p.cut_faces;
     e["components"] = p.components;
     e["substeps"] = p.substeps;

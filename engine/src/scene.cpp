@@ -189,13 +189,15 @@ void parseChips(const Reader& r, const YAML::Node& n, ChipSettings& c) {
     mode(n);
     return;
   }
-  r.checkKeys(n, "chips", {"mode", "max_chips", "drag_per_s", "angular_drag_per_s", "fluid_density_g_cm3", "friction"});
+  r.checkKeys(n, "chips",
+              {"mode", "max_chips", "drag_per_s", "angular_drag_per_s", "fluid_density_g_cm3", "friction", "optimize"});
   if (n["mode"]) mode(n["mode"]);
   if (n["max_chips"]) c.max_chips = r.integer(n["max_chips"], "max_chips", 1, 256);
   if (n["drag_per_s"]) c.drag_per_s = r.nonNegative(n["drag_per_s"], "drag_per_s");
   if (n["angular_drag_per_s"]) c.angular_drag_per_s = r.nonNegative(n["angular_drag_per_s"], "angular_drag_per_s");
   if (n["fluid_density_g_cm3"]) c.fluid_density_g_cm3 = r.nonNegative(n["fluid_density_g_cm3"], "fluid_density_g_cm3");
   if (n["friction"]) c.friction = r.nonNegative(n["friction"], "friction");
+  if (n["optimize"]) c.optimize = r.boolean(n["optimize"], "optimize");
 }
 
 haptics::Keyframe parseKeyframe(const Reader& r, const YAML::Node& n, const haptics::Keyframe* previous) {

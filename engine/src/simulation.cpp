@@ -754,6 +754,13 @@ void Simulation::finishPass() {
     const std::int64_t ticket = worker.post(beside_job);
     return [&worker, ticket] { worker.wait(ticket); };
   };
+  // chips.optimize false: the pieces the cut cuts off (chips, removed below) are not
+  // optimised; cut3d finds them with the anchors used below (the nodes' flags; by position
+  // where the cut made, moved or put a node on the cut).
+  if (!scene_.chips.optimize) {
+    options.anchored_nodes = &anchored_;
+    options.anchored_at = [this](const Eigen::Vector3d& rest) { return isAnchored(rest); };
+  }
   auto cut = cutting::cut3d(mesh_, *surface, options);
   if (!cut.ok()) return fail(cut.error());
   timer.lap(&rec.cut3d_ms);
@@ -773,6 +780,7 @@ void Simulation::finishPass() {
   rec.snapped_nodes = cut->report.snapped_nodes;
   rec.split_edges = cut->report.split_edges;
   rec.duplicated_nodes = cut->report.duplicated_nodes;
+  rec.unoptimised_chip_elements = cut->report.cut_off_elements;
   rec.cut_faces = cut->report.cut_faces;
 
   // Current positions and velocities of the new mesh: surviving nodes keep theirs (plus what

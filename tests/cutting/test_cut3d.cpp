@@ -723,6 +723,116 @@ TEST(Cut3D, UterusHalfCylinderStripSeparatesCap) {
   }
 }
 
+// Pieces the cut cuts off (no anchored node) are left as the cut made them when the anchors
+// are given: the cap of the half-cylinder strip through the myoma, with the nodes outside the
+// default scene's ellipsoid anchored. The cap is then the unoptimised cut's cap, the rest is
+// optimised and valid. With every node anchored nothing is cut off and the result is the
+// plain hybrid cut's.
+TEST(Cut3D, CutOffPiecesAreLeftAsCut) {
+  const std::string path = std::string(HYSIM_SOURCE_DIR) + "/assets/uterus_myoma.msh";
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << "no " << path;
+  const auto mesh = readTetMesh(path);
+  ASSERT_TRUE(mesh.ok()) << mesh.error();
+  const double radius = 3.5, yAxis = -0.5, z0 = -6, z1 = 14;
+  const int nu = 16, nv = 20;
+  Positions X((nu + 1) * (nv + 1), 3);
+  for (int j = 0; j <= nv; ++j)
+    for (int i = 0; i <= nu; ++i) {
+      const double a = M_PI + M_PI * i / nu;
+      X.row(j * (nu + 1) + i) << radius * std::cos(a), yAxis + radius * std::sin(a), z0 + (z1 - z0) * j / nv;
+    }
+  const CutSurface s = *CutSurface::strip(X, nv + 1, nu + 1);
+  auto outside = [](const Vec3& p) {
+    const double x = p.x() / 25, y = p.y() / 20, z = p.z() / 33;
+    return x * x + y * y + z * z > 1;
+  };
+  std::vector<std::uint8_t> flags(static_cast<size_t>(mesh->numNodes()));
+  for (int i = 0; i < mesh->numNodes(); ++i) flags[i] = outside(mesh->X.row(i).transpose()) ? 1 : 0;
+  auto anchoredOf = [&](const TetMesh& m) {
+    std::vector<int> a;
+    for (int i = 0; i < m.numNodes(); ++i)
+      if (outside(m.X.row(i).transpose())) a.push_back(i);
+    return a;
+  };
+  const Cut3DOptions plain = withMethod(CutMethod::Hybrid);
+  Cut3DOptions unoptimised = plain;
+  unoptimised.optimize.enabled = false;
+  const auto full = cut3d(*mesh, s, plain);
+  const auto bare = cut3d(*mesh, s, unoptimised);
+  ASSERT_TRUE(full.ok() && bare.ok());
+  const auto bareC = tetComponents(bare->mesh, anchoredOf(bare->mesh));
+  ASSERT_EQ(bareC.count, 2);
+  const int bareCap = bareC.free[0] ? 0 : 1;
+  ASSERT_TRUE(bareC.free[bareCap]);
+  ASSERT_FALSE(bareC.free[1 - bareCap]);
+
+  Cut3DOptions o = plain;
+  o.anchored_nodes = &flags;
+  o.anchored_at = outside;
+  const auto r = cut3d(*mesh, s, o);
+  ASSERT_TRUE(r.ok()) << r.error();
+  const auto v = validate(r->mesh);
+  EXPECT_TRUE(v.ok()) << v.error();
+  EXPECT_EQ(r->report.cut_off_pieces, 1);
+  const auto c = tetComponents(r->mesh, anchoredOf(r->mesh));
+  ASSERT_EQ(c.count, 2);
+  const int cap = c.free[0] ? 0 : 1;
+  ASSERT_TRUE(c.free[cap]);
+  EXPECT_EQ(r->report.cut_off_elements, c.elements[cap]);
+  EXPECT_EQ(c.elements[cap], bareC.elements[bareCap]);
+  EXPECT_NEAR(c.volume[cap], bareC.volume[bareCap], 1e-12 * bareC.volume[bareCap]);
+  // The cap's tets, as sorted corner positions, are the unoptimised cut's.
+  auto capTets = [](const TetMesh& m, const Components3D& comps, int label) {
+    std::vector<std::array<double, 12>> out;
+    for (int t = 0; t < m.numTets(); ++t) {
+      if (comps.label[t] != label) continue;
+      std::array<std::array<double, 3>, 4> p;
+      for (int k = 0; k < 4; ++k)
+        for (int d = 0; d < 3; ++d) p[k][d] = m.X(m.T(t, k), d);
+      std::sort(p.begin(), p.end());
+      std::array<double, 12> flat;
+      for (int k = 0; k < 4; ++k)
+        for (int d = 0; d < 3; ++d) flat[3 * k + d] = p[k][d];
+      out.push_back(flat);
+    }
+    std::sort(out.begin(), out.end());
+    return out;
+  };
+  EXPECT_EQ(capTets(r->mesh, c, cap), capTets(bare->mesh, bareC, bareCap));
+  EXPECT_NEAR(totalVolume(r->mesh), totalVolume(*mesh), 1e-3 * totalVolume(*mesh));
+  // The optimisation did its work on the rest: its worst tet is no worse than the unoptimised.
+  auto restQ = [](const TetMesh& m, const Components3D& comps, int skip) {
+    double q = 1;
+    for (int t = 0; t < m.numTets(); ++t)
+      if (comps.label[t] != skip)
+        q = std::min(q, radiusRatio(m.X.row(m.T(t, 0)).transpose(), m.X.row(m.T(t, 1)).transpose(),
+                                    m.X.row(m.T(t, 2)).transpose(), m.X.row(m.T(t, 3)).transpose()));
+    return q;
+  };
+  EXPECT_GE(restQ(r->mesh, c, cap), restQ(bare->mesh, bareC, bareCap));
+
+  // Every node anchored: nothing cut off, the plain hybrid cut.
+  std::vector<std::uint8_t> all(flags.size(), 1);
+  o.anchored_nodes = &all;
+  o.anchored_at = [](const Vec3&) { return true; };
+  const auto held = cut3d(*mesh, s, o);
+  ASSERT_TRUE(held.ok());
+  EXPECT_EQ(held->report.cut_off_pieces, 0);
+  EXPECT_TRUE(held->mesh.X == full->mesh.X);
+  EXPECT_TRUE(held->mesh.T == full->mesh.T);
+  // None anchored: the search does not look into the last piece left open when nothing holds
+  // a piece (it would hold the tissue): the cap (seen first, being small) is cut off, the
+  // rest optimised, as with the anchors.
+  std::vector<std::uint8_t> none(flags.size(), 0);
+  o.anchored_nodes = &none;
+  o.anchored_at = nullptr;
+  const auto loose = cut3d(*mesh, s, o);
+  ASSERT_TRUE(loose.ok());
+  EXPECT_EQ(loose->report.cut_off_pieces, 1);
+  EXPECT_EQ(loose->report.cut_off_elements, r->report.cut_off_elements);
+  EXPECT_TRUE(validate(loose->mesh).ok());
+}
+
 // The surface's walks (nearest point, within, segment crossing) against plain loops over every
 // triangle in input order, on random curved strips (a bent, wavy sheet, vertices jittered),
 // both trees (the strip's grid tree and the centroid-sorted one), at random points near and on

@@ -226,6 +226,41 @@ TEST(Chips, RemoveModeHasNoChipWorld) {
   EXPECT_TRUE(snap.chips.empty());
 }
 
+// chips: {optimize: false}: the cut leaves the chip as it cut it (only the slab is
+// optimised); the chip is removed all the same, the slab's mesh is valid and its worst tet
+// no worse than the unoptimised cut's bound.
+TEST(Chips, ChipsLeftUnoptimisedAreRemovedTheSame) {
+  auto scene = loadScene(writeSlabScene("leave.yaml", "chips: {mode: remove, optimize: false}"));
+  ASSERT_TRUE(scene.ok()) << scene.error();
+  EXPECT_FALSE(scene->chips.optimize);
+  EXPECT_TRUE(loadScene(writeSlabScene("keep.yaml", ""))->chips.optimize);
+  auto left = makeSim(writeSlabScene("leave.yaml", "chips: {mode: remove, optimize: false}"));
+  auto optimised = makeSim(writeSlabScene("keep.yaml", ""));
+  ASSERT_NE(left, nullptr);
+  ASSERT_NE(optimised, nullptr);
+  for (int i = 0; i < 1300; ++i) {
+    left->step();
+    optimised->step();
+  }
+  ASSERT_EQ(left->passes().size(), 1u);
+  ASSERT_FALSE(left->passes()[0].cut_failed) << left->passes()[0].message;
+  EXPECT_EQ(left->passes()[0].chips, 1);
+  EXPECT_EQ(optimised->passes()[0].chips, 1);
+  EXPECT_GT(left->passes()[0].unoptimised_chip_elements, 0);
+  EXPECT_EQ(optimised->passes()[0].unoptimised_chip_elements, 0);
+  // The same chip to within what the optimisation moves (its volume budget).
+  EXPECT_NEAR(left->passes()[0].removed_mm3, optimised->passes()[0].removed_mm3,
+              0.02 * optimised->passes()[0].removed_mm3);
+  EXPECT_TRUE(cutting::validate(left->mesh()).ok());
+  EXPECT_GE(left->passes()[0].q_min, 0.25 * optimised->passes()[0].q_min);
+  EXPECT_EQ(left->state().warnings, 0);
+
+  const std::string bad = writeSlabScene("bad_optimize.yaml", "chips: {optimize: sometimes}");
+  scene = loadScene(bad);
+  ASSERT_FALSE(scene.ok());
+  EXPECT_NE(scene.error().find(bad + ":14:"), std::string::npos) << scene.error();
+}
+
 // The chip cut off the slab's top sinks into the groove the loop left and stays there: it
 // does not fall through the tissue. Its volume counts as resected as in remove mode.
 TEST(Chips, TheCutChipRestsInItsGroove) {

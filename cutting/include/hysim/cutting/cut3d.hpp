@@ -187,6 +187,18 @@ struct Cut3DOptions {
   // work that only reads the input mesh (its node -> tets lists), done beside the surface
   // tests; the result is the same. Empty: everything runs on the calling thread.
   std::function<std::function<void()>(std::function<void()>)> beside;
+  // Optional (hybrid): the nodes that hold the tissue in place. Given, the pieces the cut
+  // cuts off (node-connected parts of the cut mesh with no anchored node, such as a chip
+  // the caller removes) are left as the cut made them: the optimisation works on the rest
+  // only, and its budgets are the rest's. They stay in the result, valid as the cut left
+  // them. anchored_nodes: a flag per input node (missing entries: not anchored), for the
+  // nodes the cut left where they were; anchored_at: for the nodes it made, moved or put on
+  // the cut, by their position (unset: not anchored). A piece counts as cut off only when
+  // the search has seen all of it; it gives up (and optimises the piece) after
+  // free_piece_search_limit nodes in all, and does not look into the last piece left open.
+  const std::vector<std::uint8_t>* anchored_nodes = nullptr;
+  std::function<bool(const Eigen::Vector3d&)> anchored_at;
+  int free_piece_search_limit = 20000;
 };
 
 struct Cut3DReport {
@@ -212,6 +224,8 @@ struct Cut3DReport {
   double peeled_volume = 0;   // their volume
   int flap_peeled = 0;        // of the peeled elements, those removed in flaps (flap_quality)
   int optimize_iterations = 0;
+  int cut_off_pieces = 0;     // pieces left out of the optimisation (anchored_nodes)
+  int cut_off_elements = 0;   // their tets
   double cut_ms = 0, optimize_ms = 0;
 };
 

@@ -54,6 +54,7 @@ struct PassRecord {
   double removed_myoma_mm3 = 0.0;
   double sweep_area_mm2 = 0.0;  // area of the cut surface (the loop's sweep)
   int crossed_edges = 0, snapped_nodes = 0, split_edges = 0, duplicated_nodes = 0, cut_faces = 0;
+  int unoptimised_chip_elements = 0;  // chips.optimize false: the tets the cut left as cut
   int components = 0;        // pieces of the cut mesh (chips included); passes() waits for it
   int substeps = 0;          // of the rebuilt model
   double added_mass_g = 0.0; // mass scaling needed to keep substeps within the cap (since the start)
