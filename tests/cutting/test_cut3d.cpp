@@ -668,20 +668,31 @@ TEST(Cut3D, UterusPlaneCutQuality) {
 // tissue between the strip and the myoma surface is enclosed and must come off. The strip is
 // curved on the scale of the elements (edges ~4 mm): the flat faces through the crossings lie
 // off the surface by their sagitta, and they must still count as cut faces.
+// The strip's vertices: rows along z (kHalfCylinderRows of them), kHalfCylinderRowSize around.
+constexpr double kHalfCylinderRadius = 3.5, kHalfCylinderAxisY = -0.5;
+constexpr int kHalfCylinderRowSize = 17, kHalfCylinderRows = 21;
+Positions halfCylinderStrip() {
+  const double z0 = -6, z1 = 14;
+  const int nu = kHalfCylinderRowSize - 1, nv = kHalfCylinderRows - 1;
+  Positions X((nu + 1) * (nv + 1), 3);
+  for (int j = 0; j <= nv; ++j)
+    for (int i = 0; i <= nu; ++i) {
+      const double a = M_PI + M_PI * i / nu;
+      X.row(j * (nu + 1) + i) << kHalfCylinderRadius * std::cos(a), kHalfCylinderAxisY + kHalfCylinderRadius * std::sin(a),
+          z0 + (z1 - z0) * j / nv;
+    }
+  return X;
+}
+
 TEST(Cut3D, UterusHalfCylinderStripSeparatesCap) {
   const std::string path = std::string(HYSIM_SOURCE_DIR) + "/assets/uterus_myoma.msh";
   if (!std::filesystem::exists(path)) GTEST_SKIP() << "no " << path;
   const auto mesh = readTetMesh(path);
   ASSERT_TRUE(mesh.ok()) << mesh.error();
-  const double radius = 3.5, yAxis = -0.5, z0 = -6, z1 = 14;
-  const int nu = 16, nv = 20;
-  Positions X((nu + 1) * (nv + 1), 3);
+  const double radius = kHalfCylinderRadius, yAxis = kHalfCylinderAxisY;
+  const int nu = kHalfCylinderRowSize - 1, nv = kHalfCylinderRows - 1;
+  const Positions X = halfCylinderStrip();
   Tris F(2 * nu * nv, 3);
-  for (int j = 0; j <= nv; ++j)
-    for (int i = 0; i <= nu; ++i) {
-      const double a = M_PI + M_PI * i / nu;
-      X.row(j * (nu + 1) + i) << radius * std::cos(a), yAxis + radius * std::sin(a), z0 + (z1 - z0) * j / nv;
-    }
   int f = 0;
   for (int j = 0; j < nv; ++j)
     for (int i = 0; i < nu; ++i) {
@@ -733,15 +744,7 @@ TEST(Cut3D, CutOffPiecesAreLeftAsCut) {
   if (!std::filesystem::exists(path)) GTEST_SKIP() << "no " << path;
   const auto mesh = readTetMesh(path);
   ASSERT_TRUE(mesh.ok()) << mesh.error();
-  const double radius = 3.5, yAxis = -0.5, z0 = -6, z1 = 14;
-  const int nu = 16, nv = 20;
-  Positions X((nu + 1) * (nv + 1), 3);
-  for (int j = 0; j <= nv; ++j)
-    for (int i = 0; i <= nu; ++i) {
-      const double a = M_PI + M_PI * i / nu;
-      X.row(j * (nu + 1) + i) << radius * std::cos(a), yAxis + radius * std::sin(a), z0 + (z1 - z0) * j / nv;
-    }
-  const CutSurface s = *CutSurface::strip(X, nv + 1, nu + 1);
+  const CutSurface s = *CutSurface::strip(halfCylinderStrip(), kHalfCylinderRows, kHalfCylinderRowSize);
   auto outside = [](const Vec3& p) {
     const double x = p.x() / 25, y = p.y() / 20, z = p.z() / 33;
     return x * x + y * y + z * z > 1;
