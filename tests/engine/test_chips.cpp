@@ -63,6 +63,14 @@ std::unique_ptr<Simulation> makeSim(const std::string& path) {
   return sim.ok() ? std::move(*sim) : nullptr;
 }
 
+// Steps two simulations side by side.
+void stepBoth(Simulation& a, Simulation& b, int steps) {
+  for (int i = 0; i < steps; ++i) {
+    a.step();
+    b.step();
+  }
+}
+
 // Lowest z of a chip's surface in the world.
 double lowestZ(const ChipBody& chip) {
   double z = 1e30;
@@ -230,18 +238,17 @@ TEST(Chips, RemoveModeHasNoChipWorld) {
 // optimised); the chip is removed all the same, the slab's mesh is valid and its worst tet
 // no worse than the unoptimised cut's bound.
 TEST(Chips, ChipsLeftUnoptimisedAreRemovedTheSame) {
-  auto scene = loadScene(writeSlabScene("leave.yaml", "chips: {mode: remove, optimize: false}"));
+  const std::string leave = writeSlabScene("leave.yaml", "chips: {mode: remove, optimize: false}");
+  const std::string keep = writeSlabScene("keep.yaml", "");
+  auto scene = loadScene(leave);
   ASSERT_TRUE(scene.ok()) << scene.error();
   EXPECT_FALSE(scene->chips.optimize);
-  EXPECT_TRUE(loadScene(writeSlabScene("keep.yaml", ""))->chips.optimize);
-  auto left = makeSim(writeSlabScene("leave.yaml", "chips: {mode: remove, optimize: false}"));
-  auto optimised = makeSim(writeSlabScene("keep.yaml", ""));
+  EXPECT_TRUE(loadScene(keep)->chips.optimize);
+  auto left = makeSim(leave);
+  auto optimised = makeSim(keep);
   ASSERT_NE(left, nullptr);
   ASSERT_NE(optimised, nullptr);
-  for (int i = 0; i < 1300; ++i) {
-    left->step();
-    optimised->step();
-  }
+  stepBoth(*left, *optimised, 1300);
   ASSERT_EQ(left->passes().size(), 1u);
   ASSERT_FALSE(left->passes()[0].cut_failed) << left->passes()[0].message;
   EXPECT_EQ(left->passes()[0].chips, 1);
@@ -268,10 +275,7 @@ TEST(Chips, TheCutChipRestsInItsGroove) {
   auto sim = makeSim(writeSlabScene("simulate.yaml", "chips: simulate"));
   ASSERT_NE(sim, nullptr);
   ASSERT_NE(removed, nullptr);
-  for (int i = 0; i < 1300; ++i) {
-    sim->step();
-    removed->step();
-  }
+  stepBoth(*sim, *removed, 1300);
   ASSERT_EQ(sim->passes().size(), 1u);
   ASSERT_FALSE(sim->passes()[0].cut_failed) << sim->passes()[0].message;
   EXPECT_EQ(sim->passes()[0].chips, 1);
