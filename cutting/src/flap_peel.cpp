@@ -187,12 +187,14 @@ void peelFlaps(const TetMesh& mesh, const CutRegion& region, const std::vector<s
       for (const std::int32_t *s = stars.begin(n), *sEnd = stars.end(n); s < sEnd; ++s) bits.mark(*s);
     bits.drainInto(cands);
   }
+  auto tetQuality = [&](int t) {
+    return quality ? (*quality)(t)
+                   : radiusRatio(pos(mesh.T(t, 0)), pos(mesh.T(t, 1)), pos(mesh.T(t, 2)), pos(mesh.T(t, 3)));
+  };
   {
     size_t kept = 0;
     for (int t : cands) {
-      const double q = quality ? (*quality)(t)
-                               : radiusRatio(pos(mesh.T(t, 0)), pos(mesh.T(t, 1)), pos(mesh.T(t, 2)),
-                                             pos(mesh.T(t, 3)));
+      const double q = tetQuality(t);
       if (q < options.flap_quality) {
         cands[kept++] = t;
         candQ.push_back(q);
@@ -383,7 +385,25 @@ void peelFlaps(const TetMesh& mesh, const CutRegion& region, const std::vector<s
       vol += volume(t);
       for (int f = 0; f < 4 && !onBoundary; ++f) onBoundary = across(t, f) < 0;
     }
-    if (!onBoundary || vol > groupLimit || vol > passLeft) continue;
+    // Poor tets inside a wedge (no boundary face): the layer of their face neighbours on the
+    // boundary that are not good either joins, within flap_grow_factor x their own volume.
+    double grownLimit = groupLimit;
+    if (!onBoundary && options.flap_grow_factor > 0) {
+      grownLimit = std::min(groupLimit, options.flap_grow_factor * vol);
+      const size_t inner = group.size();
+      for (size_t i = 0; i < inner; ++i)
+        for (int f = 0; f < 4; ++f) {
+          const int u = across(group[i], f);
+          if (u < 0 || gone[u] || std::find(group.begin(), group.end(), u) != group.end()) continue;
+          bool boundaryFace = false;
+          for (int g = 0; g < 4 && !boundaryFace; ++g) boundaryFace = across(u, g) < 0;
+          if (!boundaryFace || !(tetQuality(u) < options.quality_target)) continue;
+          group.push_back(u);
+          vol += volume(u);
+          onBoundary = true;
+        }
+    }
+    if (!onBoundary || vol > grownLimit || vol > passLeft) continue;
     int worstTet = group[0];
     {
       double wq = 2;
@@ -487,7 +507,7 @@ void peelFlaps(const TetMesh& mesh, const CutRegion& region, const std::vector<s
         grew = true;
       }
       if (!ok || !grew) break;
-      if (round >= 3 || static_cast<int>(group.size()) > options.flap_max_tets || vol > groupLimit || vol > passLeft)
+      if (round >= 3 || static_cast<int>(group.size()) > options.flap_max_tets || vol > grownLimit || vol > passLeft)
         ok = false;
     }
     // The tets next to the group must stay connected through the tets around the group's nodes.

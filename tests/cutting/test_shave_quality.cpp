@@ -279,5 +279,28 @@ TEST(ShaveQuality, CollapsesOnACutAcrossTheMyomaInterfaceKeepEachMaterialsVolume
   ASSERT_TRUE(cutDumpedPass("pass52", off, &o));
   std::printf("without the limit: material 2 %+.3f mm3\n", materialVolume(o.out.mesh, 2) - materialVolume(o.in, 2));
 }
+
+// Pass 59 of the default scene with chips left as cut (`chips: {mode: remove, optimize:
+// false}`, `hysim run --dump-cuts DIR` at c95125c, state hash 6afac5897544d5dd): the sweep
+// meets an earlier cut surface at a shallow angle, and the poor tets of the wedge between
+// them (q* 0.0196, a 0.86 mm edge beside 5-7 mm ones) have no boundary face: every node is on
+// the boundary, the better tets between them and the surface hold the faces. Their group
+// takes that layer (within flap_grow_factor x its own volume) and is peeled; without it the
+// pass leaves 0.0196, below a quarter of the initial quality.
+TEST(ShaveQuality, PoorTetsInsideAWedgeArePeeledWithTheLayerOnTheBoundary) {
+  DumpedPass p;
+  ASSERT_TRUE(cutDumpedPass("pass59c", Cut3DOptions{}, &p));
+  expectFlapCaseAccepted("pass59c", p, 5e-4);  // (volume_budget: the wedge with its layer is 8.5 mm3)
+  EXPECT_GT(p.out.report.flap_peeled, 0);
+  Cut3DOptions off;
+  off.optimize.flap_grow_factor = 0;
+  DumpedPass o;
+  ASSERT_TRUE(cutDumpedPass("pass59c", off, &o));
+  std::printf("without growing: q*_min %.4f\n", o.q_kept);
+  EXPECT_LT(o.q_kept, 0.25 * kInitialQ);
+  EXPECT_LT(o.out.report.flap_peeled, p.out.report.flap_peeled);
+  std::printf("peeled: %.2f mm3 (%d tets in flaps), without growing %.2f mm3 (%d)\n", p.out.report.peeled_volume,
+              p.out.report.flap_peeled, o.out.report.peeled_volume, o.out.report.flap_peeled);
+}
 }  // namespace
 }  // namespace hysim::cutting
