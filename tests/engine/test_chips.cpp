@@ -239,10 +239,11 @@ TEST(Chips, RemoveModeHasNoChipWorld) {
 // no worse than the unoptimised cut's bound.
 TEST(Chips, ChipsLeftUnoptimisedAreRemovedTheSame) {
   const std::string leave = writeSlabScene("leave.yaml", "chips: {mode: remove, optimize: false}");
-  const std::string keep = writeSlabScene("keep.yaml", "");
+  const std::string keep = writeSlabScene("keep.yaml", "chips: {mode: remove, optimize: true}");
   auto scene = loadScene(leave);
   ASSERT_TRUE(scene.ok()) << scene.error();
   EXPECT_FALSE(scene->chips.optimize);
+  EXPECT_FALSE(loadScene(writeSlabScene("default_optimize.yaml", ""))->chips.optimize);  // the default
   EXPECT_TRUE(loadScene(keep)->chips.optimize);
   auto left = makeSim(leave);
   auto optimised = makeSim(keep);
@@ -286,13 +287,20 @@ TEST(Chips, TheCutChipRestsInItsGroove) {
   // The chip is built from the piece's current shape, the resected volume from its rest shape
   // (the cut happens in the rest configuration): equal up to the tissue's small deformation.
   EXPECT_NEAR(start.volume_mm3, sim->passes()[0].removed_mm3, 1e-3 * sim->passes()[0].removed_mm3);
-  for (int i = 0; i < 1500; ++i) sim->step();
+  for (int i = 0; i < 1400; ++i) sim->step();
+  ASSERT_EQ(sim->chips()->numChips(), 1);
+  const Eigen::Vector3d before_last = sim->chips()->chips()[0].position;
+  for (int i = 0; i < 100; ++i) sim->step();
   ASSERT_EQ(sim->chips()->numChips(), 1);
   const ChipBody& chip = sim->chips()->chips()[0];
   // The groove's bottom is 2 mm below the slab's top (z = 0); the tissue sags a little.
   EXPECT_GT(lowestZ(chip), -2.6);
   EXPECT_LT(chip.position.z(), start.position.z() + 0.5);
-  EXPECT_LT(chip.velocity.norm(), 2.0);
+  // At rest: over the last 0.1 s it drifts less than 2 mm/s (its contact with the tissue
+  // jitters by hundredths of a millimetre).
+  const double drift_mm_s = (chip.position - before_last).norm() / 0.1;
+  std::printf("chip: drift over the last 0.1 s %.3f mm/s, speed %.3f mm/s\n", drift_mm_s, chip.velocity.norm());
+  EXPECT_LT(drift_mm_s, 2.0);
   EXPECT_LT((chip.position - start.position).norm(), 3.0);
   EXPECT_EQ(sim->state().warnings, 0);
 

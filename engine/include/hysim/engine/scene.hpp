@@ -63,7 +63,7 @@ struct ChipSettings {
   // false: the cut's optimisation leaves the pieces it cuts off (the chips) as the cut made
   // them and works on the anchored tissue only (Cut3DOptions::anchored_nodes; faster). The
   // chips' volumes are then the cut's own.
-  bool optimize = true;
+  bool optimize = false;
 };
 
 struct Scene {
