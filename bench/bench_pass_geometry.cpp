@@ -218,5 +218,31 @@ void BM_FacesPieces(benchmark::State& state) {
 }
 BENCHMARK(BM_FacesPieces)->Unit(benchmark::kMillisecond);
 
+// updateFaces alone after each dumped pass's hybrid cut (Simulation::finishPass's first step
+// after the cut), with its FaceChange; manual time per pass, counter ms_median.
+void BM_UpdateFaces(benchmark::State& state) {
+  const std::vector<CutPass>& passes = cutPasses();
+  if (passes.empty()) return state.SkipWithError("no HYSIM_REPLAY_DIR");
+  std::vector<int> next;
+  engine::FaceChange change;
+  std::vector<double> ms;
+  for (auto _ : state) {
+    double seconds = 0.0;
+    for (const CutPass& p : passes) {
+      const auto t0 = std::chrono::steady_clock::now();
+      const bool ok = engine::updateFaces(p.before, p.next_before, p.after, p.change.node_old_to_new,
+                                          p.change.element_old_to_new, next, &change);
+      const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      if (!ok) return state.SkipWithError("updateFaces failed");
+      seconds += s;
+      ms.push_back(1e3 * s);
+    }
+    state.SetIterationTime(seconds);
+  }
+  std::sort(ms.begin(), ms.end());
+  state.counters["ms_median"] = ms[ms.size() / 2];
+}
+BENCHMARK(BM_UpdateFaces)->UseManualTime()->Unit(benchmark::kMillisecond);
+
 }  // namespace
 BENCHMARK_MAIN();

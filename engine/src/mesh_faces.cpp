@@ -65,17 +65,17 @@ bool updateFaces(const cutting::TetMesh& before, const std::vector<int>& next_be
     return false;
   }
   if (T1 > 0 && (after.T.minCoeff() < 0 || after.T.maxCoeff() >= N1)) return false;
-  // The old element of each new one, when it has the same nodes in the same order; and per
-  // old slot, its neighbour slot and its own new slot (-1: its element was not kept as it
-  // was), side by side: the neighbour's pair is then one memory access (the neighbour is
-  // anywhere in the mesh; the loop below was mostly waiting for those reads). An element is
-  // kept when it maps to a new one with the same nodes: no other old element can map to that
-  // one with the same nodes too (two elements of a valid mesh never have the same nodes).
-  struct OldSlot {
-    int next, now;
-  };
+  // The old element of each new one, when it has the same nodes in the same order, and per
+  // old element 4 x its new one (-1: not kept as it was). An element is kept when it maps to
+  // a new one with the same nodes: no other old element can map to that one with the same
+  // nodes too (two elements of a valid mesh never have the same nodes).
+  // (Working arrays kept per thread between passes: every entry read is written first.)
+  thread_local std::vector<int> new_of;
+  thread_local std::vector<std::uint8_t> changed_node;
+  thread_local std::vector<int> open;  // slots to match among themselves
+  thread_local std::vector<std::pair<std::uint64_t, int>> keyed;
   std::vector<int> old_of(static_cast<size_t>(T1), -1);
-  std::vector<OldSlot> old_slot(4 * static_cast<size_t>(T0));
+  new_of.resize(static_cast<size_t>(T0));
   for (int t = 0; t < T0; ++t) {
     const int u = element_old_to_new[t];
     bool same = u >= 0 && u < T1;
@@ -84,11 +84,9 @@ bool updateFaces(const cutting::TetMesh& before, const std::vector<int>& next_be
       same = i >= 0 && i < N0 && node_old_to_new[i] == after.T(u, k);
     }
     if (same) old_of[u] = t;
-    const size_t s = 4 * static_cast<size_t>(t);
-    const int now = same ? 4 * u : -1;
-    for (int f = 0; f < 4; ++f) old_slot[s + f] = {next_before[s + f], same ? now + f : -1};
+    new_of[t] = same ? 4 * u : -1;
   }
-  std::vector<std::uint8_t> changed_node(static_cast<size_t>(N1), 0);
+  changed_node.assign(static_cast<size_t>(N1), 0);
   for (int u = 0; u < T1; ++u)
     if (old_of[u] < 0)
       for (int k = 0; k < 4; ++k) changed_node[after.T(u, k)] = 1;
@@ -96,8 +94,7 @@ bool updateFaces(const cutting::TetMesh& before, const std::vector<int>& next_be
   // themselves collected after, in the same order): few values live across the faces, so
   // the loop keeps them in registers.
   std::vector<int> out(4 * static_cast<size_t>(T1));  // every entry written here
-  std::vector<int> open;  // slots to match among themselves
-  const OldSlot* const slots = old_slot.data();
+  open.clear();
   for (int u = 0; u < T1; ++u) {
     const int o = old_of[u];
     int* const row = out.data() + 4 * static_cast<size_t>(u);
@@ -106,15 +103,15 @@ bool updateFaces(const cutting::TetMesh& before, const std::vector<int>& next_be
       row[0] = row[1] = row[2] = row[3] = -1;
       open_faces = 15;
     } else {
-      const OldSlot* const mine = slots + 4 * static_cast<size_t>(o);
+      const int* const mine = next_before.data() + 4 * static_cast<size_t>(o);
       for (int f = 0; f < 4; ++f) {
-        const int p = mine[f].next;
+        const int p = mine[f];
         int now = -1;
         if (p >= 0) {
           // Kept when both elements are kept as they were and the face had just the two.
-          const OldSlot other = p / 4 < T0 ? slots[p] : OldSlot{-1, -1};
-          if (other.now >= 0 && other.next == 4 * o + f) {
-            now = other.now;
+          const int q = p / 4 < T0 ? new_of[p / 4] : -1;
+          if (q >= 0) {
+            now = q + p % 4;
           } else {
             open_faces |= 1u << f;
           }
@@ -131,36 +128,28 @@ bool updateFaces(const cutting::TetMesh& before, const std::vector<int>& next_be
     for (int f = 0; open_faces != 0; ++f, open_faces >>= 1)
       if (open_faces & 1u) open.push_back(4 * u + f);
   }
-  struct Entry {
-    int a, b, c, slot;
-  };
-  std::vector<Entry> entries;
-  entries.reserve(open.size());
+  // The open faces by their sorted nodes (a < b < c) packed into one key, 21 bits each (node
+  // ids below 2^21, checked), then the slot: equal faces next to each other, in slot order.
+  if (N1 >= (1 << 21)) return false;
+  keyed.clear();
   for (int s : open) {
     const int t = s / 4;
     const int* local = kTetFace[s % 4];
-    int a = after.T(t, local[0]), b = after.T(t, local[1]), c = after.T(t, local[2]);
+    std::uint64_t a = static_cast<std::uint32_t>(after.T(t, local[0])), b = static_cast<std::uint32_t>(after.T(t, local[1])),
+                  c = static_cast<std::uint32_t>(after.T(t, local[2]));
     if (a > b) std::swap(a, b);
     if (b > c) std::swap(b, c);
     if (a > b) std::swap(a, b);
-    entries.push_back({a, b, c, s});
+    keyed.emplace_back(a << 42 | b << 21 | c, s);
   }
-  std::sort(entries.begin(), entries.end(), [](const Entry& x, const Entry& y) {
-    if (x.a != y.a) return x.a < y.a;
-    if (x.b != y.b) return x.b < y.b;
-    if (x.c != y.c) return x.c < y.c;
-    return x.slot < y.slot;
-  });
-  for (size_t i = 0; i < entries.size();) {
+  std::sort(keyed.begin(), keyed.end());
+  for (size_t i = 0; i < keyed.size();) {
     size_t j = i + 1;
-    while (j < entries.size() && entries[j].a == entries[i].a && entries[j].b == entries[i].b &&
-           entries[j].c == entries[i].c) {
-      ++j;
-    }
+    while (j < keyed.size() && keyed[j].first == keyed[i].first) ++j;
     if (j - i > 2) return false;  // a face of three elements: not a cut of a valid mesh
     if (j - i == 2) {
-      out[entries[i].slot] = entries[i + 1].slot;
-      out[entries[i + 1].slot] = entries[i].slot;
+      out[keyed[i].second] = keyed[i + 1].second;
+      out[keyed[i + 1].second] = keyed[i].second;
     }
     i = j;
   }

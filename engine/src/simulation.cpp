@@ -904,9 +904,7 @@ void Simulation::finishPass() {
   }
   // The kept mesh (rest positions, tets), its positions, velocities and anchors, and its
   // boundary: the kept tets' faces that no other tet shares (a kept tet's neighbours are in
-  // its component, so kept too), in the order cutting::boundaryFaces gives. The worker then
-  // also finds the kept mesh's face neighbours, for the next pass (a kept tet's neighbours
-  // are kept).
+  // its component, so kept too), in the order cutting::boundaryFaces gives.
   cutting::TetMesh rest_mesh;
   sim::NodeVectors x_kept, v_kept;
   std::vector<std::uint8_t> anchored_kept, kept_boundary;
@@ -937,23 +935,6 @@ void Simulation::finishPass() {
   }
   auto geometry_job = [&] {
     geometry = buildGeometry(rest_mesh, x_kept, &rec, kept_boundary.empty() ? nullptr : &kept_boundary, &old_to_kept);
-    if (face_next.empty()) return;
-    if (keep_tets.size() == static_cast<size_t>(after.numTets())) {  // no piece removed
-      kept_next = face_next;
-      return;
-    }
-    std::vector<int> kept_of(static_cast<size_t>(after.numTets()), -1);
-    for (size_t k = 0; k < keep_tets.size(); ++k) kept_of[keep_tets[k]] = static_cast<int>(k);
-    kept_next.resize(4 * keep_tets.size());
-    for (size_t k = 0; k < keep_tets.size() && !kept_next.empty(); ++k)
-      for (int f = 0; f < 4; ++f) {
-        const int p = face_next[4 * static_cast<size_t>(keep_tets[k]) + f];
-        if (p >= 0 && kept_of[p / 4] < 0) {  // not reached: pieces are closed under faces
-          kept_next.clear();
-          break;
-        }
-        kept_next[4 * k + f] = p < 0 ? -1 : 4 * kept_of[p / 4] + p % 4;
-      }
   };
   const std::int64_t geometry_ticket = worker.post(geometry_job);
   // The serosa follows its nodes into the new numbering.
@@ -1000,6 +981,27 @@ void Simulation::finishPass() {
     chip_shapes = chipShapes(deformed, v, comps, on_cut, scene_.materials, myoma_label);
   }
   timer.lap(&rec.chips_ms);
+  // The kept mesh's face neighbours, for the next pass (a kept tet's neighbours are kept),
+  // while the worker finishes the model's first part.
+  if (!face_next.empty()) {
+    if (keep_tets.size() == static_cast<size_t>(after.numTets())) {  // no piece removed
+      kept_next = face_next;
+    } else {
+      std::vector<int> kept_of(static_cast<size_t>(after.numTets()), -1);
+      for (size_t k = 0; k < keep_tets.size(); ++k) kept_of[keep_tets[k]] = static_cast<int>(k);
+      kept_next.resize(4 * keep_tets.size());
+      for (size_t k = 0; k < keep_tets.size() && !kept_next.empty(); ++k)
+        for (int f = 0; f < 4; ++f) {
+          const int p = face_next[4 * static_cast<size_t>(keep_tets[k]) + f];
+          if (p >= 0 && kept_of[p / 4] < 0) {  // not reached: pieces are closed under faces
+            kept_next.clear();
+            break;
+          }
+          kept_next[4 * k + f] = p < 0 ? -1 : 4 * kept_of[p / 4] + p % 4;
+        }
+    }
+  }
+  timer.lap(&rec.components_ms);
   // The tissue model, updated around the cut (moment-preserving masses, Van Gelder springs,
   // stability estimate near the cut); the chips leave with their masses.
   sim::CutUpdate3DReport update;

@@ -31,7 +31,9 @@ bool matchFaces(const cutting::TetMesh& mesh, std::vector<int>& next);
 // belongs to a changed element; the other slots (the changed elements', and those next to
 // them) are matched among themselves. Linear in #T with a small constant, sorting only the
 // slots near the cut. Returns false (next untouched) when it cannot tell: sizes that do not
-// match, a face of more than two elements, node ids out of range; matchFaces then.
+// match, a face of more than two elements among the slots matched anew, node ids out of
+// range (2^21 or more), matchFaces then. next_before must pair its slots (a face of at most
+// two elements: matchFaces' and updateFaces' next of a valid mesh), as it is not checked.
 // What updateFaces finds on the way, for freePiecesAfterCut.
 struct FaceChange {
   // #T of after: the element of before with the same nodes in the same order, or -1.
