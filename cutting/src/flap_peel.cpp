@@ -14,7 +14,10 @@
 // Rule: candidates are the live tets with q* below flap_quality that have a node within
 // flap_rings edge steps of the seeds (what the cut touched, and every node on the cut).
 // Candidates sharing faces form
-// groups; a group with at least one boundary face is removed when
+// groups; a group without a boundary face (poor tets inside a wedge whose nodes are all on the
+// boundary) first takes the layer of its face neighbours that have one and q* below
+// quality_target, within flap_grow_factor x its own volume (repairs below included); a group
+// with at least one boundary face is removed when
 //  - its volume is at most flap_group_volume x a regular tet with the cut's local edge, and
 //    all removed flaps of this cut together at most flap_pass_volume x that;
 //  - every node of the group keeps a manifold star (its remaining tets connected through

@@ -60,9 +60,9 @@ struct ChipSettings {
   double angular_drag_per_s = 20.0;   // same for the angular velocity
   double fluid_density_g_cm3 = 1.0;   // buoyancy: a chip sinks with g (1 - rho_fluid / rho_chip)
   double friction = 0.8;              // Coulomb friction coefficient on the wall and the tool
-  // false: the cut's optimisation leaves the pieces it cuts off (the chips) as the cut made
-  // them and works on the anchored tissue only (Cut3DOptions::anchored_nodes; faster). The
-  // chips' volumes are then the cut's own.
+  // false (the default): the cut's optimisation leaves the pieces it cuts off (the chips) as
+  // the cut made them and works on the anchored tissue only (Cut3DOptions::anchored_nodes;
+  // faster). The chips' volumes are then the cut's own. true: the chips are optimised too.
   bool optimize = false;
 };
 
