@@ -65,6 +65,7 @@ bool updateFaces(const cutting::TetMesh& before, const std::vector<int>& next_be
     return false;
   }
   if (T1 > 0 && (after.T.minCoeff() < 0 || after.T.maxCoeff() >= N1)) return false;
+  if (N1 >= (1 << 21)) return false;  // (the open faces' keys below pack three node ids)
   // The old element of each new one, when it has the same nodes in the same order, and per
   // old element 4 x its new one (-1: not kept as it was). An element is kept when it maps to
   // a new one with the same nodes: no other old element can map to that one with the same
@@ -129,8 +130,8 @@ bool updateFaces(const cutting::TetMesh& before, const std::vector<int>& next_be
       if (open_faces & 1u) open.push_back(4 * u + f);
   }
   // The open faces by their sorted nodes (a < b < c) packed into one key, 21 bits each (node
-  // ids below 2^21, checked), then the slot: equal faces next to each other, in slot order.
-  if (N1 >= (1 << 21)) return false;
+  // ids below 2^21, checked above), then the slot: equal faces next to each other, in slot
+  // order.
   keyed.clear();
   for (int s : open) {
     const int t = s / 4;

@@ -296,11 +296,11 @@ TEST(Chips, TheCutChipRestsInItsGroove) {
   // The groove's bottom is 2 mm below the slab's top (z = 0); the tissue sags a little.
   EXPECT_GT(lowestZ(chip), -2.6);
   EXPECT_LT(chip.position.z(), start.position.z() + 0.5);
-  // At rest: over the last 0.1 s it drifts less than 2 mm/s (its contact with the tissue
-  // jitters by hundredths of a millimetre).
+  // At rest: over the last 0.1 s it drifts less than 0.5 mm/s (0.12 measured; its contact
+  // with the tissue jitters by hundredths of a millimetre, at up to 3 mm/s).
   const double drift_mm_s = (chip.position - before_last).norm() / 0.1;
   std::printf("chip: drift over the last 0.1 s %.3f mm/s, speed %.3f mm/s\n", drift_mm_s, chip.velocity.norm());
-  EXPECT_LT(drift_mm_s, 2.0);
+  EXPECT_LT(drift_mm_s, 0.5);
   EXPECT_LT((chip.position - start.position).norm(), 3.0);
   EXPECT_EQ(sim->state().warnings, 0);
 
