@@ -21,6 +21,23 @@ void fillStepSprings(Model& model, int count);
 // than a full eigenvalue solve; its value can differ from one in those last bits.
 double topTridiagonalEigenvalue(const Eigen::VectorXd& diag, const Eigen::VectorXd& sub);
 
+// A Aᵀ (K x K, K fixed) summed column by column in index order, the same bits on every
+// machine. (Eigen's general product splits a long inner dimension into blocks sized from the
+// CPU's cache sizes, so its rounding, and with it the masses after a cut and the whole run
+// that follows, differed between machines: a 48 KiB L1 gave another default run than 32 KiB.)
+template <int K, class Mat>
+Eigen::Matrix<double, K, K> gramFixedOrder(const Mat& A) {
+  Eigen::Matrix<double, K, K> B = Eigen::Matrix<double, K, K>::Zero();
+  for (Eigen::Index j = 0; j < A.cols(); ++j)
+    for (int c = 0; c < K; ++c) {
+      const double ac = A(c, j);
+      for (int r = c; r < K; ++r) B(r, c) += A(r, j) * ac;
+    }
+  for (int c = 0; c < K; ++c)
+    for (int r = c + 1; r < K; ++r) B(c, r) = B(r, c);
+  return B;
+}
+
 // The ten monomials up to second order of a point (1, x, y, z, x², y², z², xy, yz, zx):
 // the mass moments the tissue updates after a cut keep.
 using Row10 = Eigen::Matrix<double, 10, 1>;

@@ -7,6 +7,8 @@
 #include <utility>
 #include <vector>
 
+#include "model_internal.hpp"
+
 namespace hysim::sim {
 
 namespace {
@@ -129,7 +131,7 @@ Result<Eigen::VectorXd> updateMasses2D(const cutting::TriMesh& before, const Eig
     const Row6 r = p - A * mfix;
     Eigen::MatrixXd Af(6, free.size());
     for (std::size_t k = 0; k < free.size(); ++k) Af.col(static_cast<int>(k)) = A.col(free[k]);
-    const Eigen::Matrix<double, 6, 6> B = Af * Af.transpose();
+    const Eigen::Matrix<double, 6, 6> B = gramFixedOrder<6>(Af);
     Eigen::CompleteOrthogonalDecomposition<Eigen::Matrix<double, 6, 6>> cod(B);
     if (cod.rank() < 6 && !rep.global) {
       // Local nodes do not determine all six moments: use every node.

@@ -108,7 +108,7 @@ int correctMassMoments(const cutting::Positions& X, const std::vector<int>& unkn
     Eigen::Matrix<double, 10, Eigen::Dynamic> A(10, static_cast<Eigen::Index>(active.size()));
     for (size_t j = 0; j < active.size(); ++j)
       A.col(static_cast<Eigen::Index>(j)) = monomials((X.row(active[j]).transpose() - centre) / scale);
-    const Eigen::Matrix<double, 10, 10> B = A * A.transpose();
+    const Eigen::Matrix<double, 10, 10> B = gramFixedOrder<10>(A);
     const Row10 y = Eigen::CompleteOrthogonalDecomposition<Eigen::Matrix<double, 10, 10>>(B).solve(r);
     const Eigen::VectorXd dm = A.transpose() * y;
     bool any = false;
