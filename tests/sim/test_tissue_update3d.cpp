@@ -63,8 +63,11 @@ TEST(TissueUpdate3D, MassesAreTheSameForAnyCpuCacheSizes) {
   auto r = cutting::cut3d(box, *cutting::CutSurface::plane(Vec3(1.71, 1.63, 1.77), Vec3(0.3, 0.2, 1)), {});
   ASSERT_TRUE(r.ok()) << r.error();
   const Eigen::VectorXd density = Eigen::VectorXd::Constant(r->mesh.numTets(), 1e-3);
-  std::ptrdiff_t l1 = 0, l2 = 0, l3 = 0;
-  Eigen::internal::manage_caching_sizes(Eigen::GetAction, &l1, &l2, &l3);
+  struct RestoreCacheSizes {  // Eigen's setting is global: put it back on every way out
+    std::ptrdiff_t l1 = 0, l2 = 0, l3 = 0;
+    RestoreCacheSizes() { Eigen::internal::manage_caching_sizes(Eigen::GetAction, &l1, &l2, &l3); }
+    ~RestoreCacheSizes() { Eigen::setCpuCacheSizes(l1, l2, l3); }
+  } restore;
   std::vector<Eigen::VectorXd> masses;
   MassUpdate3DReport report;
   for (const std::ptrdiff_t kib : {32, 48, 64}) {
@@ -73,7 +76,6 @@ TEST(TissueUpdate3D, MassesAreTheSameForAnyCpuCacheSizes) {
     ASSERT_TRUE(m.ok()) << m.error();
     masses.push_back(*m);
   }
-  Eigen::setCpuCacheSizes(l1, l2, l3);
   EXPECT_GT(report.unknowns, 1000);  // well past where the blocking splits the sum
   EXPECT_LT(report.moment_residual, 1e-9);
   for (size_t k = 1; k < masses.size(); ++k) {
