@@ -53,6 +53,13 @@ TEST(TissueUpdate3D, MassesKeepMomentsForEveryMethod) {
   }
 }
 
+// Eigen's cache sizes are global: the tests that set them put them back on every way out.
+struct RestoreCacheSizes {
+  std::ptrdiff_t l1 = 0, l2 = 0, l3 = 0;
+  RestoreCacheSizes() { Eigen::internal::manage_caching_sizes(Eigen::GetAction, &l1, &l2, &l3); }
+  ~RestoreCacheSizes() { Eigen::setCpuCacheSizes(l1, l2, l3); }
+};
+
 // The masses after a cut do not depend on the CPU's cache sizes. (Eigen's general product
 // sizes its blocks of a long inner dimension from them; with > ~550 unknowns, A Aᵀ in the
 // moment correction rounded differently on a 48 KiB L1 than on a 32 KiB one, and the default
@@ -63,11 +70,7 @@ TEST(TissueUpdate3D, MassesAreTheSameForAnyCpuCacheSizes) {
   auto r = cutting::cut3d(box, *cutting::CutSurface::plane(Vec3(1.71, 1.63, 1.77), Vec3(0.3, 0.2, 1)), {});
   ASSERT_TRUE(r.ok()) << r.error();
   const Eigen::VectorXd density = Eigen::VectorXd::Constant(r->mesh.numTets(), 1e-3);
-  struct RestoreCacheSizes {  // Eigen's setting is global: put it back on every way out
-    std::ptrdiff_t l1 = 0, l2 = 0, l3 = 0;
-    RestoreCacheSizes() { Eigen::internal::manage_caching_sizes(Eigen::GetAction, &l1, &l2, &l3); }
-    ~RestoreCacheSizes() { Eigen::setCpuCacheSizes(l1, l2, l3); }
-  } restore;
+  RestoreCacheSizes restore;
   std::vector<Eigen::VectorXd> masses;
   MassUpdate3DReport report;
   for (const std::ptrdiff_t kib : {32, 48, 64}) {
@@ -83,6 +86,25 @@ TEST(TissueUpdate3D, MassesAreTheSameForAnyCpuCacheSizes) {
     EXPECT_EQ(0, std::memcmp(masses[k].data(), masses[0].data(), sizeof(double) * masses[0].size()))
         << "L1 setting " << k;
   }
+}
+
+// gramFixedOrder, as the 2D update calls it (a dynamic 6-row matrix): A Aᵀ to rounding,
+// symmetric, and the same bits whatever the cache sizes Eigen is told.
+TEST(TissueUpdate3D, GramInFixedOrderIsTheProductWithTheSameBitsForAnyCacheSizes) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  Eigen::MatrixXd A(6, 3000);
+  for (Eigen::Index j = 0; j < A.cols(); ++j)
+    for (int i = 0; i < 6; ++i) A(i, j) = u(rng);
+  RestoreCacheSizes restore;
+  Eigen::setCpuCacheSizes(32 * 1024, 1280 * 1024, 32 * 1024 * 1024);
+  const Eigen::Matrix<double, 6, 6> B = gramFixedOrder<6>(A);
+  const Eigen::MatrixXd ref = A * A.transpose();
+  EXPECT_LT((B - ref).cwiseAbs().maxCoeff(), 1e-12 * ref.cwiseAbs().maxCoeff());
+  EXPECT_TRUE(B == B.transpose());
+  Eigen::setCpuCacheSizes(48 * 1024, 1280 * 1024, 32 * 1024 * 1024);
+  const Eigen::Matrix<double, 6, 6> B48 = gramFixedOrder<6>(A);
+  EXPECT_EQ(0, std::memcmp(B.data(), B48.data(), sizeof(double) * 36));
 }
 
 TEST(TissueUpdate3D, RepeatedCutsKeepMoments) {
