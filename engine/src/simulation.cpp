@@ -414,12 +414,13 @@ bool Simulation::mapToRest(const Eigen::Vector3d& p, double displacement, Eigen:
   return true;
 }
 
-bool Simulation::mapRow(int row, const Eigen::Vector3d& shift) {
+bool Simulation::mapRow(int row, const Eigen::Vector3d& shift, bool last_rows) {
   // A query looks at the cells within the nodes' largest displacement since the locator's
   // build: past a millimetre, a fresh build (~0.6 ms) costs less than the row's queries
-  // over the rest of the pass.
+  // over the rest of the pass. For the pass's last rows (last_rows) it does not: they are
+  // the locator's last queries before the cut rebuilds it anyway.
   double displacement = locator_.maxDisplacement(state_.x);
-  if (displacement > 1.0) {
+  if (displacement > 1.0 && !last_rows) {
     locator_.build(mesh_, state_.x);
     displacement = 0.0;
   }
@@ -431,13 +432,13 @@ bool Simulation::mapRow(int row, const Eigen::Vector3d& shift) {
   return true;
 }
 
-void Simulation::mapSweepRows() {
+void Simulation::mapSweepRows(bool last_rows) {
   const int rows = sweep_.numRows(), n = sweep_.rowSize();
   if (rows < 2 || map_failed_) return;
   waitLocator();  // the last pass's locator and nearest-node lookups (long done, in practice)
   if (rest_rows_.empty()) {  // the row before the start
     const Eigen::Vector3d shift = -1.5 * sweep_.motion(0, 1);
-    if (!mapRow(0, shift)) {
+    if (!mapRow(0, shift, last_rows)) {
       map_failed_ = true;
       return;
     }
@@ -446,7 +447,7 @@ void Simulation::mapSweepRows() {
   for (; swept_rows_mapped_ < rows; ++swept_rows_mapped_) {
     const Eigen::Vector3d middle = sweep_.point(swept_rows_mapped_, n / 2);
     if ((middle - kept_middle_).norm() < 0.3) continue;
-    if (!mapRow(swept_rows_mapped_, Eigen::Vector3d::Zero())) {
+    if (!mapRow(swept_rows_mapped_, Eigen::Vector3d::Zero(), last_rows)) {
       map_failed_ = true;
       return;
     }
@@ -722,8 +723,8 @@ void Simulation::finishPass() {
   // sweep's rows up to this step were carried to the rest shape as they came (mapSweepRows:
   // a row every ~0.3 mm, through the tissue as it was then); the row 1.5 mm past the end
   // follows now.
-  mapSweepRows();
-  if (!map_failed_ && !mapRow(rows - 1, 1.5 * sweep_.motion(rows - 2, rows - 1))) map_failed_ = true;
+  mapSweepRows(true);
+  if (!map_failed_ && !mapRow(rows - 1, 1.5 * sweep_.motion(rows - 2, rows - 1), true)) map_failed_ = true;
   sweep_.clear();
   if (map_failed_) return fail("no tissue to map the sweep to");
   const int kept = static_cast<int>(rest_rows_.size()) / row_size;

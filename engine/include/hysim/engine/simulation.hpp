@@ -182,13 +182,17 @@ class Simulation {
   // 0.3 mm or more (its middle point) from the last kept one is carried from the tissue as it
   // is at that step to the rest shape (mapToRest), so the cut follows the material the wire
   // passed through when it passed. The first call also maps the row 1.5 mm before the start.
-  void mapSweepRows();
+  // last_rows: the pass ends (see mapRow).
+  void mapSweepRows(bool last_rows = false);
   // Rest position of the point p of the deformed tissue: through the tet that contains it
   // (state_.x), else the affine map of a tet at the nearest surface node, which continues the
   // deformation smoothly. False when there is no tissue to map to.
   bool mapToRest(const Eigen::Vector3d& p, double displacement, Eigen::Vector3d& rest) const;
   // Appends row `row` of the sweep (or, with `shift`, that row moved by it) to rest_rows_.
-  bool mapRow(int row, const Eigen::Vector3d& shift);
+  // The locator is rebuilt first when the nodes moved more than a millimetre since its
+  // build, unless these are the pass's last rows (last_rows): the answers are the same
+  // either way (locate() gives the lowest-numbered tet holding the point, whatever the grid).
+  bool mapRow(int row, const Eigen::Vector3d& shift, bool last_rows = false);
   // The lookups mapToRest needs besides the locator, for mesh_ at positions x: the nearest
   // surface node (over a copy of x, surface_nodes_) and a tet at each node. Built with the
   // locator (after a pass: on its background thread).
