@@ -418,9 +418,10 @@ bool Simulation::mapRow(int row, const Eigen::Vector3d& shift, bool last_rows) {
   // A query looks at the cells within the nodes' largest displacement since the locator's
   // build: past a millimetre, a fresh build (~0.6 ms) costs less than the row's queries
   // over the rest of the pass. For the pass's last rows (last_rows) it does not: they are
-  // the locator's last queries before the cut rebuilds it anyway.
+  // the locator's last queries before the cut rebuilds it anyway (up to the locator's
+  // margin, the displacement it is built for).
   double displacement = locator_.maxDisplacement(state_.x);
-  if (displacement > 1.0 && !last_rows) {
+  if (displacement > (last_rows ? locator_.margin() : 1.0)) {
     locator_.build(mesh_, state_.x);
     displacement = 0.0;
   }

@@ -57,5 +57,42 @@ TEST(TetLocator, SameAnswerWhereverTheGridWasBuilt) {
   }
 }
 
+// The same with the nodes moved by up to the margin (the pass maps its last sweep rows through
+// a locator built up to that far from where the tissue is, instead of rebuilding it).
+TEST(TetLocator, SameAnswerAfterMovesUpToTheMargin) {
+  cutting::TetMesh mesh = testing::boxTetMesh(8, 7, 6, 1.5);
+  for (const double amplitude : {1.5, 2.5}) {
+    sim::NodeVectors x1 = mesh.X;
+    for (int i = 0; i < x1.rows(); ++i) {
+      x1(i, 0) += amplitude * std::sin(0.25 * mesh.X(i, 1));
+      x1(i, 1) += 0.5 * amplitude * std::cos(0.2 * mesh.X(i, 2));
+    }
+    TetLocator before, fresh;
+    before.build(mesh, mesh.X);
+    fresh.build(mesh, x1);
+    const double moved = before.maxDisplacement(x1);
+    ASSERT_GT(moved, 0.9 * amplitude);
+    ASSERT_LE(moved, before.margin());
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> where(-4.0, 16.0);
+    int inside = 0;
+    for (int q = 0; q < 4000; ++q) {
+      const Eigen::Vector3d p(where(rng), where(rng), where(rng));
+      const int a = before.locate(mesh, x1, p, moved);
+      EXPECT_EQ(a, fresh.locate(mesh, x1, p, 0.0)) << "amplitude " << amplitude;
+      inside += a >= 0;
+    }
+    EXPECT_GT(inside, 500);
+    for (int t = 0; t < mesh.numTets(); ++t) {
+      Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+      for (int k = 0; k < 4; ++k) centroid += 0.25 * x1.row(mesh.T(t, k)).transpose();
+      const int a = before.locate(mesh, x1, centroid, moved);
+      EXPECT_EQ(a, fresh.locate(mesh, x1, centroid, 0.0));
+      EXPECT_GE(a, 0);
+      EXPECT_LE(a, t);
+    }
+  }
+}
+
 }  // namespace
 }  // namespace hysim::engine

@@ -190,8 +190,9 @@ class Simulation {
   bool mapToRest(const Eigen::Vector3d& p, double displacement, Eigen::Vector3d& rest) const;
   // Appends row `row` of the sweep (or, with `shift`, that row moved by it) to rest_rows_.
   // The locator is rebuilt first when the nodes moved more than a millimetre since its
-  // build, unless these are the pass's last rows (last_rows): the answers are the same
-  // either way (locate() gives the lowest-numbered tet holding the point, whatever the grid).
+  // build, or, for the pass's last rows (last_rows), more than its margin: the answers are
+  // the same either way (locate() gives the lowest-numbered tet holding the point, whatever
+  // the grid).
   bool mapRow(int row, const Eigen::Vector3d& shift, bool last_rows = false);
   // The lookups mapToRest needs besides the locator, for mesh_ at positions x: the nearest
   // surface node (over a copy of x, surface_nodes_) and a tet at each node. Built with the
