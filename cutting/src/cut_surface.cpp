@@ -80,11 +80,14 @@ void CutSurface::finish(const std::vector<Tri>& tri) {
 }
 
 void CutSurface::finishWalkData() {
-  childBoxes_.assign(nodes_.size(), ChildBoxes{});
+  childBoxes_.resize(nodes_.size());
   for (size_t id = 0; id < nodes_.size(); ++id) {
     const Node& node = nodes_[id];
-    if (node.left < 0) continue;
     ChildBoxes& c = childBoxes_[id];
+    if (node.left < 0) {  // unused; written so that every entry has a value
+      c = ChildBoxes{};
+      continue;
+    }
     for (int k = 0; k < 3; ++k) {
       c.lo[k][0] = nodes_[node.left].box.min()[k];
       c.lo[k][1] = nodes_[node.right].box.min()[k];
@@ -92,29 +95,21 @@ void CutSurface::finishWalkData() {
       c.hi[k][1] = nodes_[node.right].box.max()[k];
     }
   }
-  nearTri_.resize(leafTri_.size());
+  nearPairs_.resize(leafTri_.size());
+  planePairs_.resize(leafTri_.size());
   for (size_t i = 0; i < leafTri_.size(); ++i) {
     const Tri& t = leafTri_[i].t;
-    nearTri_[i] = {t.a, t.b, t.c, t.b - t.a, t.c - t.a, t.c - t.b};
-  }
-  nearPairs_.resize(leafTri_.size());
-  for (size_t i = 0; i < leafTri_.size(); ++i) {
-    const NearTri& t = nearTri_[i];
+    const Eigen::Vector3d ab = t.b - t.a, ac = t.c - t.a;
     NearPairs& pp = nearPairs_[i];
+    PlanePairs& pl = planePairs_[i];
     for (int k = 0; k < 3; ++k) {
       pp.a[k][0] = pp.a[k][1] = t.a[k];
       pp.b[k][0] = pp.b[k][1] = t.b[k];
       pp.c[k][0] = pp.c[k][1] = t.c[k];
-      pp.e[k][0] = t.ab[k];
-      pp.e[k][1] = t.ac[k];
-    }
-  }
-  planePairs_.resize(leafTri_.size());
-  for (size_t i = 0; i < leafTri_.size(); ++i) {
-    const Tri& t = leafTri_[i].t;
-    for (int k = 0; k < 3; ++k) {
-      planePairs_[i].p0[k][0] = planePairs_[i].p0[k][1] = t.a[k];
-      planePairs_[i].n[k][0] = planePairs_[i].n[k][1] = t.n[k];
+      pp.e[k][0] = ab[k];
+      pp.e[k][1] = ac[k];
+      pl.p0[k][0] = pl.p0[k][1] = t.a[k];
+      pl.n[k][0] = pl.n[k][1] = t.n[k];
     }
   }
 }
@@ -367,8 +362,7 @@ inline int CutSurface::childrenMeet(int id, const double* lohi) const {
 namespace {
 // The nearest point of triangle (a, b, c) to p, by the Voronoi-region walk (Ericson,
 // Real-Time Collision Detection, 5.1.5), with its edges ab = b - a, ac = c - a, bc = c - b
-// given (the nearest-point searches read them from a table made with the tree); inlined into
-// their leaf loops, which call it millions of times.
+// given; inlined into the leaf loops of builds without SSE2, which call it millions of times.
 #if defined(__GNUC__)
 __attribute__((always_inline))
 #endif
@@ -411,8 +405,14 @@ inline Eigen::Vector3d closestPointOnTriangleInline(const Eigen::Vector3d& p, co
 __attribute__((always_inline))
 #endif
 inline Eigen::Vector3d CutSurface::closestPointPaired(const double* xx, int i) const {
-  const NearTri& t = nearTri_[i];
   const NearPairs& pp = nearPairs_[i];
+  // The triangle's vertices and edges from the first of each pair (c - b formed here, the
+  // same operation on the same values as closestPointOnTriangle's).
+  auto first = [](const double (*v)[2]) { return Eigen::Vector3d(v[0][0], v[1][0], v[2][0]); };
+  auto second = [](const double (*v)[2]) { return Eigen::Vector3d(v[0][1], v[1][1], v[2][1]); };
+  struct {
+    Eigen::Vector3d a, b, c, ab, ac;
+  } t{first(pp.a), first(pp.b), first(pp.c), first(pp.e), second(pp.e)};
   auto dots = [&](const double (*v)[2]) {
     __m128d s[3];
     for (int k = 0; k < 3; ++k)
@@ -433,7 +433,7 @@ inline Eigen::Vector3d CutSurface::closestPointPaired(const double* xx, int i) c
   const double vb = d5 * d2 - d1 * d6;
   if (vb <= 0 && d2 >= 0 && d6 <= 0) return t.a + (d2 / (d2 - d6)) * t.ac;
   const double va = d3 * d6 - d5 * d4;
-  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) return t.b + ((d4 - d3) / ((d4 - d3) + (d5 - d6))) * t.bc;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) return t.b + ((d4 - d3) / ((d4 - d3) + (d5 - d6))) * (t.c - t.b);
   const double denom = 1.0 / (va + vb + vc);
   return t.a + t.ab * (vb * denom) + t.ac * (vc * denom);
 }
@@ -448,12 +448,12 @@ inline Eigen::Vector3d CutSurface::nearestOnLeaf(const double* xx, const Eigen::
   const Eigen::Vector3d q = closestPointPaired(xx, i);
 #else
   (void)xx;
-  const NearTri& t = nearTri_[i];
-  const Eigen::Vector3d q = closestPointWithEdges(x, t.a, t.b, t.c, t.ab, t.ac, t.bc);
+  const Tri& t = leafTri_[i].t;
+  const Eigen::Vector3d q = closestPointOnTriangleInline(x, t.a, t.b, t.c);
 #endif
 #ifdef HYSIM_CHECK_EXACT
   {
-    const NearTri& t = nearTri_[i];
+    const Tri& t = leafTri_[i].t;
     const Eigen::Vector3d ref = closestPointOnTriangleInline(x, t.a, t.b, t.c);
     if (std::memcmp(ref.data(), q.data(), sizeof(double) * 3) != 0) std::abort();
   }

@@ -15,6 +15,8 @@
 // plane" cuts well defined: those nodes are on the cut and nothing is subdivided there.
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <memory>
+#include <new>
 #include <utility>
 #include <vector>
 
@@ -88,13 +90,10 @@ class CutSurface {
   struct alignas(16) ChildBoxes {
     double lo[3][2], hi[3][2];
   };
-  // Per leaf triangle, what the nearest-point searches read: its vertices, and b - a, c - a,
-  // c - b as closestPointOnTriangle computes them.
-  struct NearTri {
-    Eigen::Vector3d a, b, c, ab, ac, bc;
-  };
   // Per leaf triangle, its vertices axis by axis, each value twice, and (b - a, c - a) axis by
-  // axis: the nearest-point test takes two dot products with one vertex at once.
+  // axis: the nearest-point test takes two dot products with one vertex at once (and reads
+  // the point it returns from the first of each pair: c - b is formed there, as
+  // closestPointOnTriangle forms it).
   struct alignas(16) NearPairs {
     double a[3][2], b[3][2], c[3][2], e[3][2];
   };
@@ -118,8 +117,8 @@ class CutSurface {
   // triangles.
   void finish(const std::vector<Tri>& tri);
   int build(int begin, int end, BuildScratch& scratch);
-  // childBoxes_, nearTri_, nearPairs_ and planePairs_ from nodes_ and leafTri_ (after the
-  // tree is built).
+  // childBoxes_, nearPairs_ and planePairs_ from nodes_ and leafTri_ (after the tree is
+  // built), each entry written once (the arrays are not zero-filled first).
   void finishWalkData();
   // One step of a nearest-point walk at inner node `id` (see there); xx: the point's
   // coordinates, each twice (x0 x0 x1 x1 x2 x2, 16-byte aligned).
@@ -144,10 +143,29 @@ class CutSurface {
   std::vector<int> order_;        // tree order -> input triangle index
   std::vector<Node> nodes_;
   std::vector<LeafTri> leafTri_;  // the triangles in tree order: input triangle order_[i] at i
-  std::vector<ChildBoxes> childBoxes_;  // by node id (a leaf's entry unused)
-  std::vector<NearTri> nearTri_;        // by place in leafTri_
-  std::vector<PlanePairs> planePairs_;  // by place in leafTri_
-  std::vector<NearPairs> nearPairs_;    // by place in leafTri_
+  // Vectors whose resize() leaves new plain-data entries uninitialised (default-init, not
+  // value-init): finishWalkData writes every entry once.
+  template <class T>
+  struct UninitAllocator : std::allocator<T> {
+    template <class U>
+    struct rebind {
+      using other = UninitAllocator<U>;
+    };
+    UninitAllocator() = default;
+    template <class U>
+    UninitAllocator(const UninitAllocator<U>&) noexcept {}
+    template <class U>
+    void construct(U* p) noexcept {
+      ::new (static_cast<void*>(p)) U;
+    }
+    template <class U, class... Args>
+    void construct(U* p, Args&&... args) {
+      ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+    }
+  };
+  std::vector<ChildBoxes, UninitAllocator<ChildBoxes>> childBoxes_;  // by node id (a leaf's entry zero)
+  std::vector<PlanePairs, UninitAllocator<PlanePairs>> planePairs_;  // by place in leafTri_
+  std::vector<NearPairs, UninitAllocator<NearPairs>> nearPairs_;     // by place in leafTri_
   Eigen::AlignedBox3d bounds_;
 };
 
