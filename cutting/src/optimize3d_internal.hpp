@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "hysim/cutting/cut3d.hpp"
+#include "hysim/cutting/no_init_allocator.hpp"
 
 namespace hysim::cutting {
 
@@ -43,27 +44,6 @@ struct IndexBits {
   std::vector<std::int32_t> words;
 };
 
-// std::allocator, except that a value-initialisation (what resize(n) does to new elements)
-// leaves them default-initialised: new ints are not zeroed, for arrays that are written in
-// full right after they grow (the node->tet lists' `star`: 4 x #T entries per cut).
-template <class T>
-struct NoInitAllocator : std::allocator<T> {
-  template <class U>
-  struct rebind {
-    using other = NoInitAllocator<U>;
-  };
-  NoInitAllocator() = default;
-  template <class U>
-  NoInitAllocator(const NoInitAllocator<U>&) noexcept {}
-  template <class U>
-  void construct(U* p) noexcept {
-    ::new (static_cast<void*>(p)) U;
-  }
-  template <class U, class... Args>
-  void construct(U* p, Args&&... args) {
-    ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
-  }
-};
 using StarVector = std::vector<std::int32_t, NoInitAllocator<std::int32_t>>;
 
 // Node -> tet lists of a tet mesh (each list ascending): CSR rows (off, star), or, where

@@ -15,12 +15,11 @@
 // plane" cuts well defined: those nodes are on the cut and nothing is subdivided there.
 #include <Eigen/Core>
 #include <Eigen/Geometry>
-#include <memory>
-#include <new>
 #include <utility>
 #include <vector>
 
 #include "hysim/cutting/mesh.hpp"
+#include "hysim/cutting/no_init_allocator.hpp"
 #include "hysim/cutting/result.hpp"
 
 namespace hysim::cutting {
@@ -143,29 +142,11 @@ class CutSurface {
   std::vector<int> order_;        // tree order -> input triangle index
   std::vector<Node> nodes_;
   std::vector<LeafTri> leafTri_;  // the triangles in tree order: input triangle order_[i] at i
-  // Vectors whose resize() leaves new plain-data entries uninitialised (default-init, not
-  // value-init): finishWalkData writes every entry once.
-  template <class T>
-  struct UninitAllocator : std::allocator<T> {
-    template <class U>
-    struct rebind {
-      using other = UninitAllocator<U>;
-    };
-    UninitAllocator() = default;
-    template <class U>
-    UninitAllocator(const UninitAllocator<U>&) noexcept {}
-    template <class U>
-    void construct(U* p) noexcept {
-      ::new (static_cast<void*>(p)) U;
-    }
-    template <class U, class... Args>
-    void construct(U* p, Args&&... args) {
-      ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
-    }
-  };
-  std::vector<ChildBoxes, UninitAllocator<ChildBoxes>> childBoxes_;  // by node id (a leaf's entry zero)
-  std::vector<PlanePairs, UninitAllocator<PlanePairs>> planePairs_;  // by place in leafTri_
-  std::vector<NearPairs, UninitAllocator<NearPairs>> nearPairs_;     // by place in leafTri_
+  // (NoInitAllocator: resize() leaves the new entries uninitialised; finishWalkData writes
+  // every entry once.)
+  std::vector<ChildBoxes, NoInitAllocator<ChildBoxes>> childBoxes_;  // by node id (a leaf's entry zero)
+  std::vector<PlanePairs, NoInitAllocator<PlanePairs>> planePairs_;  // by place in leafTri_
+  std::vector<NearPairs, NoInitAllocator<NearPairs>> nearPairs_;     // by place in leafTri_
   Eigen::AlignedBox3d bounds_;
 };
 
