@@ -19,8 +19,11 @@ namespace {
 
 namespace fs = std::filesystem;
 
+// This test's own folder (ctest runs the tests side by side as separate processes: with a
+// shared folder one could read slab.msh while another is still writing it).
 fs::path outputDir() {
-  const fs::path dir = fs::path(HYSIM_TEST_OUTPUT_DIR) / "chips";
+  const fs::path dir =
+      fs::path(HYSIM_TEST_OUTPUT_DIR) / "chips" / ::testing::UnitTest::GetInstance()->current_test_info()->name();
   fs::create_directories(dir);
   return dir;
 }

@@ -19,12 +19,21 @@ namespace {
 
 namespace fs = std::filesystem;
 
+// This test's own folder for the files it writes (ctest runs the tests of this file as
+// separate processes side by side: a shared folder would have one rewrite another's mesh
+// while it is read).
+fs::path testDir() {
+  const fs::path dir =
+      fs::path(HYSIM_TEST_OUTPUT_DIR) / "shaving" / ::testing::UnitTest::GetInstance()->current_test_info()->name();
+  fs::create_directories(dir);
+  return dir;
+}
+
 // Slab 30 x 20 x 10 mm, top face at z = 0, anchored at the bottom. The scope points along
 // +x with up = +z, so the loop (radius 3.5, centre 3 mm below the axis) hangs down; its
 // lowest point is 2 mm below the slab's top.
 std::string writeSlabScene(bool pedal) {
-  const fs::path dir = fs::path(HYSIM_TEST_OUTPUT_DIR) / "shaving";
-  fs::create_directories(dir);
+  const fs::path dir = testDir();
   cutting::TetMesh slab = testing::boxTetMesh(15, 10, 5, 2.0);
   for (int i = 0; i < slab.numNodes(); ++i) slab.X.row(i) -= Eigen::RowVector3d(15, 10, 10);
   EXPECT_TRUE(cutting::writeMesh((dir / "slab.msh").string(), slab).ok());
@@ -144,7 +153,7 @@ TEST(Shaving, EntryAndExitAtTheSlabsFaces) {
 // The pedal goes down while the whole loop is buried in the slab (no surface near the wire):
 // the point-in-tissue test makes that an entry on the first step.
 TEST(Shaving, ABuriedLoopEntersWhenThePedalGoesDown) {
-  const fs::path dir = fs::path(HYSIM_TEST_OUTPUT_DIR) / "shaving";
+  const fs::path dir = testDir();
   writeSlabScene(true);  // writes slab.msh
   std::ofstream(dir / "slab_buried.yaml")
       << "name: slab buried\n"
@@ -191,8 +200,7 @@ TEST(Shaving, SamePassTwiceGivesTheSameState) {
 // of the first, so their sweeps cross the first pass's cut surface, as shaving does): after
 // every pass the mesh is valid (no inverted or flat tet, manifold, no duplicate faces).
 TEST(Shaving, OverlappingPassesKeepTheMeshValid) {
-  const fs::path dir = fs::path(HYSIM_TEST_OUTPUT_DIR) / "shaving";
-  fs::create_directories(dir);
+  const fs::path dir = testDir();
   cutting::TetMesh slab = testing::boxTetMesh(15, 10, 5, 2.0);
   for (int i = 0; i < slab.numNodes(); ++i) slab.X.row(i) -= Eigen::RowVector3d(15, 10, 10);
   ASSERT_TRUE(cutting::writeMesh((dir / "slab.msh").string(), slab).ok());
@@ -248,7 +256,7 @@ TEST(Shaving, DumpedCutInputRepeatsThePassesCut) {
   ASSERT_TRUE(scene.ok()) << scene.error();
   auto sim = Simulation::create(*scene);
   ASSERT_TRUE(sim.ok()) << sim.error();
-  const fs::path dir = fs::path(HYSIM_TEST_OUTPUT_DIR) / "shaving" / "dump";
+  const fs::path dir = testDir() / "dump";
   fs::remove_all(dir);
   fs::create_directories(dir);
   (*sim)->setCutDumpDir(dir.string());
