@@ -9,6 +9,7 @@
 
 #include "alloc_counter.hpp"
 #include "box_mesh.hpp"
+#include "test_dir.hpp"
 #include "hysim/cutting/mesh_io.hpp"
 #include "hysim/engine/chips.hpp"
 #include "hysim/engine/scene.hpp"
@@ -19,14 +20,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// This test's own folder (ctest runs the tests side by side as separate processes: with a
-// shared folder one could read slab.msh while another is still writing it).
-fs::path outputDir() {
-  const fs::path dir =
-      fs::path(HYSIM_TEST_OUTPUT_DIR) / "chips" / ::testing::UnitTest::GetInstance()->current_test_info()->name();
-  fs::create_directories(dir);
-  return dir;
-}
+// The running test's own folder (test_dir.hpp).
+fs::path outputDir() { return testing::testDir("chips"); }
 
 // The slab of test_shaving (30 x 20 x 10 mm, top at z = 0, anchored at the bottom), with
 // gravity along -z; one pass of the active loop cuts a 2 mm deep chip off the top.

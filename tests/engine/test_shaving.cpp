@@ -8,6 +8,7 @@
 
 #include "alloc_counter.hpp"
 #include "box_mesh.hpp"
+#include "test_dir.hpp"
 #include "hysim/cutting/cut3d.hpp"
 #include "hysim/cutting/mesh_io.hpp"
 #include "hysim/engine/run.hpp"
@@ -19,15 +20,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// This test's own folder for the files it writes (ctest runs the tests of this file as
-// separate processes side by side: a shared folder would have one rewrite another's mesh
-// while it is read).
-fs::path testDir() {
-  const fs::path dir =
-      fs::path(HYSIM_TEST_OUTPUT_DIR) / "shaving" / ::testing::UnitTest::GetInstance()->current_test_info()->name();
-  fs::create_directories(dir);
-  return dir;
-}
+// The running test's own folder (test_dir.hpp).
+fs::path testDir() { return testing::testDir("shaving"); }
 
 // Slab 30 x 20 x 10 mm, top face at z = 0, anchored at the bottom. The scope points along
 // +x with up = +z, so the loop (radius 3.5, centre 3 mm below the axis) hangs down; its
