@@ -1445,6 +1445,7 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
     }
     const size_t before = moved.size();
     OptimizeCounts counts;
+    region.beside = options.beside;
     optimizeAroundCut(out, region, options.optimize, &moved, &peeled, &counts);
     if (region.left_alone != nullptr)
       for (size_t t = 0; t < cutOffTets.size(); ++t)

@@ -133,7 +133,6 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   const double cosCurved =
       curved ? std::cos(std::max(options.boundary_flat_deg, options.boundary_curved_deg) * M_PI / 180.0) : cosFlat;
   const double cosRidge = std::cos(options.ridge_deg * M_PI / 180.0);
-  std::vector<std::array<Vec3, 3>> fan;  // constraintOf's Fan: the node's boundary faces
 
   // Node -> tets of the whole mesh (one O(#T) pass, or taken over from region.stars;
   // everything else is local), live tets in index order. After edge collapses the lists of
@@ -322,9 +321,13 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     double q;
     std::int8_t up;  // tetVolume6Here > 0 at these positions (1, 0), -1: not asked yet
   };
+  // (At most one entry per tet. The move loop's two lanes (see there) take new entries from
+  // the two ends: lane 0 from the front, lane 1 from the back, so neither writes where the
+  // other does; which slot an entry has changes nothing else.)
   std::vector<std::int32_t> qSlot(M, -1);
-  std::vector<QEntry> qPool;
-  qPool.reserve(M);  // (at most one entry per tet: the pool is never moved as it grows)
+  std::vector<QEntry, NoInitAllocator<QEntry>> qPool(static_cast<size_t>(M));
+  std::int32_t qNext[2] = {0, M - 1};
+  auto newQSlot = [&](int lane) { return lane == 0 ? qNext[0]++ : qNext[1]--; };
   auto tetQ = [&](int t) {
     QEntry cur;
     for (int k = 0; k < 4; ++k) {
@@ -336,8 +339,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       const QEntry& e = qPool[slot];
       if (std::equal(cur.v, cur.v + 4, e.v) && std::equal(cur.ver, cur.ver + 4, e.ver)) return e.q;
     } else {
-      slot = static_cast<std::int32_t>(qPool.size());
-      qPool.emplace_back();
+      slot = newQSlot(0);
     }
     cur.q = radiusRatio(pos(cur.v[0]), pos(cur.v[1]), pos(cur.v[2]), pos(cur.v[3]));
     cur.up = -1;
@@ -346,7 +348,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   };
   // vol6 > 0 ? tetQ(t) : -1 (vol6 = tetVolume6Here(mesh, t)), the sign cached with q*.
   // (An entry is only made where vol6 > 0, as tetQ is only asked there.)
-  auto tetQUp = [&](int t) {
+  auto tetQUp = [&](int t, int lane = 0) {
     QEntry cur;
     for (int k = 0; k < 4; ++k) {
       cur.v[k] = mesh.T(t, k);
@@ -361,10 +363,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       }
     }
     if (!(tetVolume6Here(mesh, t) > 0)) return -1.0;
-    if (slot < 0) {
-      slot = static_cast<std::int32_t>(qPool.size());
-      qPool.emplace_back();
-    }
+    if (slot < 0) slot = newQSlot(lane);
     cur.q = radiusRatio(pos(cur.v[0]), pos(cur.v[1]), pos(cur.v[2]), pos(cur.v[3]));
     cur.up = 1;
     qPool[slot] = cur;
@@ -381,12 +380,12 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     return radiusRatioOriented(pos(a), pos(b), pos(c), pos(d));
   };
   // Worst q* around n where it is (tetQAt at its own position, through the cache).
-  auto starWorst = [&](int n, int* worstTet) {
+  auto starWorst = [&](int n, int* worstTet, int lane = 0) {
     double q = 1.0;
     for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s) {
       const int t = (*s);
       if ((*dead)[t]) continue;
-      const double qt = tetQUp(t);  // -1 where not (p1 - p0).dot((p2 - p0).cross(p3 - p0)) > 0
+      const double qt = tetQUp(t, lane);  // -1 where not (p1 - p0).dot((p2 - p0).cross(p3 - p0)) > 0
       if (qt < q) {
         q = qt;
         if (worstTet) *worstTet = (*s);
@@ -431,43 +430,57 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     *q = std::min(1.0, worst);
     return true;
   };
-  // Scratch for constraintOf and discAround: a node's neighbours, their local numbers (-1
-  // elsewhere), a table over pairs of them.
-  std::vector<std::int32_t> nbrs, localId(N, -1), pairCount;
   // Where node n may move (see the file comment).
   // The faces around n by the pair of their nodes other than n: where first seen (tet, face),
   // how many tets use them, the table entry; pairCount is -1 everywhere between calls.
   struct FaceUse {
     std::int32_t t, f, count, key;
   };
-  std::vector<FaceUse> consFaces;
-  std::vector<std::int32_t> consLocal;  // per live star tet: its tet, then its nodes' local numbers (n: -1)
   // The boundary faces around n (used by one tet), in the order first seen.
   struct BFace {
     std::int32_t u, v;
     Vec3 area;  // outward area vector (x2 the area)
     Vec3 unit;  // area.normalized()
   };
-  std::vector<BFace> faces;
+  // constraintOf's scratch, one per lane of the move loop (lane 0 everywhere else):
+  //  - a node's neighbours, their local numbers (-1 elsewhere; lane 0's also discAround's), a
+  //    table over pairs of them;
+  //  - the faces by pair (consFaces), per live star tet its tet, then its nodes' local numbers
+  //    (n: -1) (consLocal);
+  //  - the boundary faces (faces) and, for Fan, their corners (fan);
+  //  - the kept boundary faces of the nodes this lane looked at (bfPool, see bfStart).
+  struct ConsLane {
+    std::vector<std::int32_t> nbrs, localId, pairCount, consLocal;
+    std::vector<FaceUse> consFaces;
+    std::vector<BFace> faces;
+    std::vector<std::array<Vec3, 3>> fan;
+    std::vector<std::array<std::int32_t, 2>> bfPool;
+  };
+  ConsLane consLane[2];
+  consLane[0].localId.assign(N, -1);
+  std::vector<std::int32_t>& localId = consLane[0].localId;
   // The move loop changes positions only, never which tets are live or their nodes, so the
   // boundary faces around a node, as (tet, face) in the order first seen, are the same at
-  // every call there: kept per node (bfStart[n] >= 0: bfLen[n] entries of bfPool from there).
-  // Empty bfStart: no keeping (the mesh may change between calls).
+  // every call there: kept per node (bfStart[n] >= 0: bfLen[n] entries of lane bfLane[n]'s
+  // bfPool from there). Empty bfStart: no keeping (the mesh may change between calls).
   std::vector<std::int32_t> bfStart, bfLen;
-  std::vector<std::array<std::int32_t, 2>> bfPool;
-  auto constraintOf = [&](int n) {
+  std::vector<std::uint8_t> bfLane;
+  bool lanesApart = false;  // the move loop's lanes run side by side now
+  auto constraintOf = [&](int n, int lane = 0) {
+    ConsLane& S = consLane[lane];
     Constraint c;
-    faces.clear();
+    S.faces.clear();
     const bool keep = !bfStart.empty();
-    if (!keep || bfStart[n] < 0) {
-      if (!keep) bfPool.clear();
-      consFaces.clear();
+    // (A lane beside the other keeps its own copy: the other's pool may grow meanwhile.)
+    if (!keep || bfStart[n] < 0 || (lanesApart && bfLane[n] != lane)) {
+      if (!keep) S.bfPool.clear();
+      S.consFaces.clear();
       // Faces by the pair of their nodes other than n (local numbers over n's neighbours).
-      nbrs.clear();
+      S.nbrs.clear();
       const std::int32_t *sBegin = starB(n), *sEnd = starE(n);
       const size_t recs = 5 * static_cast<size_t>(sEnd - sBegin);
-      if (consLocal.size() < recs) consLocal.resize(recs);
-      std::int32_t* cl = consLocal.data();
+      if (S.consLocal.size() < recs) S.consLocal.resize(recs);
+      std::int32_t* cl = S.consLocal.data();
       for (const std::int32_t* s = sBegin; s < sEnd; ++s)
         if (!(*dead)[*s]) {
           *cl++ = *s;
@@ -477,17 +490,17 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
               *cl++ = -1;
               continue;
             }
-            if (localId[w] < 0) {
-              localId[w] = static_cast<std::int32_t>(nbrs.size());
-              nbrs.push_back(w);
+            if (S.localId[w] < 0) {
+              S.localId[w] = static_cast<std::int32_t>(S.nbrs.size());
+              S.nbrs.push_back(w);
             }
-            *cl++ = localId[w];
+            *cl++ = S.localId[w];
           }
         }
       const std::int32_t* clEnd = cl;
-      const size_t L = nbrs.size();
-      if (pairCount.size() < L * L) pairCount.assign(L * L, -1);  // index into consFaces
-      for (const std::int32_t* rec = consLocal.data(); rec < clEnd; rec += 5) {
+      const size_t L = S.nbrs.size();
+      if (S.pairCount.size() < L * L) S.pairCount.assign(L * L, -1);  // index into S.consFaces
+      for (const std::int32_t* rec = S.consLocal.data(); rec < clEnd; rec += 5) {
         const std::int32_t* lt = rec + 1;
         int ln = 0;
         while (lt[ln] >= 0) ++ln;
@@ -499,27 +512,31 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
         for (int r = 0; r < 3; ++r) {
           const std::int32_t x = lt[p[r == 0 ? 1 : 0]], y = lt[p[r == 2 ? 1 : 2]];
           const std::int32_t key = std::min(x, y) * static_cast<std::int32_t>(L) + std::max(x, y);
-          std::int32_t& at = pairCount[key];
+          std::int32_t& at = S.pairCount[key];
           if (at >= 0) {
-            ++consFaces[at].count;
+            ++S.consFaces[at].count;
           } else {
-            at = static_cast<std::int32_t>(consFaces.size());
-            consFaces.push_back({rec[0], p[r], 1, key});
+            at = static_cast<std::int32_t>(S.consFaces.size());
+            S.consFaces.push_back({rec[0], p[r], 1, key});
           }
         }
       }
-      for (int w : nbrs) localId[w] = -1;
-      if (keep) bfStart[n] = static_cast<std::int32_t>(bfPool.size());
-      for (const FaceUse& fu : consFaces) {
-        pairCount[fu.key] = -1;
-        if (fu.count != 1) continue;
-        bfPool.push_back({fu.t, fu.f});
+      for (int w : S.nbrs) S.localId[w] = -1;
+      if (keep) {
+        bfStart[n] = static_cast<std::int32_t>(S.bfPool.size());
+        bfLane[n] = static_cast<std::uint8_t>(lane);
       }
-      if (keep) bfLen[n] = static_cast<std::int32_t>(bfPool.size()) - bfStart[n];
+      for (const FaceUse& fu : S.consFaces) {
+        S.pairCount[fu.key] = -1;
+        if (fu.count != 1) continue;
+        S.bfPool.push_back({fu.t, fu.f});
+      }
+      if (keep) bfLen[n] = static_cast<std::int32_t>(S.bfPool.size()) - bfStart[n];
     }
     Vec3 sum = Vec3::Zero();
     bool boundary = false, allCut = true;
     const std::int32_t bfFrom = keep ? bfStart[n] : 0;
+    const auto& bfPool = keep ? consLane[bfLane[n]].bfPool : S.bfPool;
     const std::int32_t bfTo = keep ? bfStart[n] + bfLen[n] : static_cast<std::int32_t>(bfPool.size());
     for (std::int32_t bi = bfFrom; bi < bfTo; ++bi) {
       const int t = bfPool[bi][0], f = bfPool[bi][1];
@@ -529,7 +546,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
         if (v != n) o[m++] = v;
       if (o[0] > o[1]) std::swap(o[0], o[1]);
       const Vec3 area = (pos(i1) - pos(i0)).cross(pos(i2) - pos(i0));
-      faces.push_back({o[0], o[1], area, area.normalized()});
+      S.faces.push_back({o[0], o[1], area, area.normalized()});
       boundary = true;
       sum += area;
       allCut = allCut && onCut[o[0]] && onCut[o[1]];
@@ -537,19 +554,19 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     const bool nodeOnCut = onCut[n] != 0;
     // A node on a ridge (the rim, where the cut meets the boundary, or a crease of the
     // boundary) slides along it: exactly two of its boundary edges are ridge edges (between a
-    // cut and a non-cut face, or faces more than ridge_deg apart).
+    // cut and a non-cut face, or S.faces more than ridge_deg apart).
     auto ridgeOf = [&]() {
       if (!curved || !(options.ridge_deg > 0)) return false;
       int found = 0;
-      for (size_t i = 0; i < faces.size(); ++i) {
-        for (int w : {faces[i].u, faces[i].v})
-          for (size_t j = i + 1; j < faces.size(); ++j) {
-            if (faces[j].u != w && faces[j].v != w) continue;
-            const bool cutI = onCut[faces[i].u] && onCut[faces[i].v] && nodeOnCut;
-            const bool cutJ = onCut[faces[j].u] && onCut[faces[j].v] && nodeOnCut;
+      for (size_t i = 0; i < S.faces.size(); ++i) {
+        for (int w : {S.faces[i].u, S.faces[i].v})
+          for (size_t j = i + 1; j < S.faces.size(); ++j) {
+            if (S.faces[j].u != w && S.faces[j].v != w) continue;
+            const bool cutI = onCut[S.faces[i].u] && onCut[S.faces[i].v] && nodeOnCut;
+            const bool cutJ = onCut[S.faces[j].u] && onCut[S.faces[j].v] && nodeOnCut;
             // (On the cut only the rim counts: the node is put back onto the cut surface.)
             const bool edge = nodeOnCut ? cutI != cutJ
-                                        : faces[i].unit.dot(faces[j].unit) < cosRidge;
+                                        : S.faces[i].unit.dot(S.faces[j].unit) < cosRidge;
             if (!edge) continue;
             if (found == 2) return false;
             c.ridge[found++] = pos(w);
@@ -574,9 +591,9 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       if (!boundary || sum.norm() == 0) return c;
       c.normal = sum.normalized();
       // A curved cut surface: slide in the tangent plane, then back onto the surface (the
-      // volume changes by second-order amounts), where the cut faces around are smooth.
+      // volume changes by second-order amounts), where the cut S.faces around are smooth.
       c.kind = Freedom::Surface;
-      for (const auto& bf : faces)
+      for (const auto& bf : S.faces)
         if (bf.unit.dot(c.normal) < cosCurved) c.kind = Freedom::Fixed;
       return c;
     }
@@ -587,7 +604,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     if (!options.move_boundary_nodes || sum.norm() == 0) return c;
     c.normal = sum.normalized();
     c.kind = Freedom::Plane;
-    for (const auto& bf : faces) {
+    for (const auto& bf : S.faces) {
       const double cosine = bf.unit.dot(c.normal);
       if (cosine < cosCurved) {
         c.kind = Freedom::Fixed;
@@ -596,9 +613,9 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       }
       if (cosine < cosFlat) c.kind = Freedom::Fan;
     }
-    if (c.kind == Freedom::Fan) {  // the node stays on its boundary faces as they are now
-      fan.clear();
-      for (const auto& bf : faces) fan.push_back({pos(n), pos(bf.u), pos(bf.v)});
+    if (c.kind == Freedom::Fan) {  // the node stays on its boundary S.faces as they are now
+      S.fan.clear();
+      for (const auto& bf : S.faces) S.fan.push_back({pos(n), pos(bf.u), pos(bf.v)});
     }
     return c;
   };
@@ -1825,19 +1842,24 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     Vec3 x;
     double d;  // exact: |signed distance|; bound: the distance is above it
     Vec3 closest;
-    std::int8_t kind = 0;  // 0 none, 1 exact, 2 lower bound
+    std::int8_t kind;  // 0 none, 1 exact, 2 lower bound (set when the entry is made)
   };
+  // (At most one entry per node; the move loop's lanes take new ones from the two ends, as
+  // qPool's.)
   std::vector<std::int32_t> distSlot;
-  std::vector<DistEntry> distPool;
-  auto distEntry = [&](int n) -> DistEntry& {
-    if (distSlot.empty()) {
-      distSlot.assign(N, -1);
-      distPool.reserve(N);  // (at most one entry per node: never moved as it grows)
-    }
+  std::vector<DistEntry, NoInitAllocator<DistEntry>> distPool;
+  std::int32_t distNext[2] = {0, N - 1};
+  auto distInit = [&] {  // (before the move loop's lanes ask: they must not both make the tables)
+    if (!distSlot.empty()) return;
+    distSlot.assign(N, -1);
+    distPool.resize(N);
+  };
+  auto distEntry = [&](int n, int lane = 0) -> DistEntry& {
+    distInit();
     std::int32_t& slot = distSlot[n];
     if (slot < 0) {
-      slot = static_cast<std::int32_t>(distPool.size());
-      distPool.emplace_back();
+      slot = lane == 0 ? distNext[0]++ : distNext[1]--;
+      distPool[slot].kind = 0;
     }
     DistEntry& e = distPool[slot];
     if (e.kind != 0 && e.x != pos(n)) e.kind = 0;
@@ -1847,8 +1869,8 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   // known to be within (within() said so, or n is on the cut and `within` the on-surface
   // tolerance), for the bounded search, which gives signedDistance's value and point (and
   // searches everything after all where nothing is that near).
-  auto nodeDistance = [&](int n, Vec3* closest, double within = std::numeric_limits<double>::infinity()) {
-    DistEntry& e = distEntry(n);
+  auto nodeDistance = [&](int n, Vec3* closest, double within = std::numeric_limits<double>::infinity(), int lane = 0) {
+    DistEntry& e = distEntry(n, lane);
     if (e.kind != 1) {
       e.x = pos(n);
       e.d = std::abs(region.surface->signedDistanceNear(e.x, within, &e.closest));
@@ -1858,8 +1880,8 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     return e.d;
   };
   // region.surface->within(pos(n), r).
-  auto nodeWithin = [&](int n, double r) {
-    DistEntry& e = distEntry(n);
+  auto nodeWithin = [&](int n, double r, int lane = 0) {
+    DistEntry& e = distEntry(n, lane);
     if (e.kind == 1) return e.d <= r;
     if (e.kind == 2 && r <= e.d) return false;
     const bool in = region.surface->within(pos(n), r);
@@ -2155,263 +2177,422 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     if (n >= 0 && n < N) addBadAround(n, 0);
   std::vector<std::uint8_t> didMove(N, 0);
   std::vector<std::int32_t> movedNow;
-  std::vector<double> starVolume;  // per node in the move loop, filled when first needed
   struct StarVolTet {  // per live star tet in the move loop's volume check (see there)
     double p[3][4];    // the corners' x, y, z
     double a[3], b[3], e[3], nrm[3];  // p1 - p0, p2 - p0, p3 - p0, b x e (where kn != 0)
     double old;        // its volume where n is
     int kn;            // n's corner
   };
-  std::vector<StarVolTet> starVol;
+  // The move loop's two lanes (see moveRun): what each gathers and its scratch.
+  struct MoveLane {
+    std::vector<std::int32_t> moved;  // the nodes it moved, in order
+    std::vector<double> starVolume;   // per node, filled when first needed
+    std::vector<StarVolTet> starVol;
+    double largest = 0, scale = 0;
+    bool split = false;      // beside the other lane: the budget's half, its own version numbers
+    double net = 0, churn = 0;  // (split) the volume change it spent
+    std::uint32_t nextVer = 0;  // (split) the next version number it gives a node
+  };
+  MoveLane moveLane[2];
+  // Does a move's volume change dv fit the move budget? Beside the other lane, a lane has half
+  // the room left at the start: |net + 2 (its net + dv)| <= limit and the same for the churn,
+  // so whatever both spend, the sum fits (the halves' mean does), in any order.
+  auto moveFits = [&](const MoveLane& L, double dv) {
+    if (!L.split) return moveBudget.fits(dv);
+    return std::abs(moveBudget.net + 2.0 * (L.net + dv)) <= moveBudget.limit &&
+           moveBudget.churn + 2.0 * (L.churn + std::abs(dv)) <= moveBudget.churn_factor * moveBudget.limit;
+  };
+  // One node's move (the file comment), on lane `lane`: it reads the positions of n and its
+  // neighbours and writes n's.
+  auto moveNode = [&](int n, int lane) {
+    MoveLane& L = moveLane[lane];
+    // (The cached quality test before the constraint, which looks at the whole star.)
+    int wt = -1;
+    const double before = starWorst(n, &wt, lane);
+    if (before < 0 || before >= options.quality_target || wt < 0) return;
+    const Constraint c = constraintOf(n, lane);
+    if (c.kind == Freedom::Fixed) return;
+    const Vec3 x = pos(n);
+    auto project = [&](Vec3 d) {
+      if (c.kind != Freedom::Free && c.kind != Freedom::Ridge) d -= d.dot(c.normal) * c.normal;
+      return d;
+    };
+    // Unit direction of the allowed part of d (zero when d is (nearly) all normal: the
+    // remainder would be rounding noise).
+    auto unitIn = [&](const Vec3& d) {
+      const Vec3 p = project(d);
+      const double len = p.norm();
+      return len > 1e-6 * d.norm() && len > 0 ? Vec3(project(p / len)) : Vec3::Zero();
+    };
+    double sum = 0;
+    int deg = 0;
+    Vec3 force = Vec3::Zero();
+    for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s) {
+      if ((*dead)[(*s)]) continue;
+      for (int k = 0; k < 4; ++k) {
+        const int m = mesh.T((*s), k);
+        if (m == n) continue;
+        sum += (pos(m) - x).norm();
+        ++deg;
+      }
+    }
+    if (deg == 0) return;
+    const double h = sum / deg;
+    L.scale = std::max(L.scale, h);
+    for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s) {
+      if ((*dead)[(*s)]) continue;
+      for (int k = 0; k < 4; ++k) {
+        const int m = mesh.T((*s), k);
+        if (m == n) continue;
+        const Vec3 d = pos(m) - x;
+        const double len = d.norm();
+        if (len > 0) force += (len - h) * d / len;
+      }
+    }
+    // The worst tet's corners, n's at wtK (for tetQAt(wt, n, y) below: the same values).
+    Vec3 wtP[4];
+    int wtK = -1;
+    for (int k = 0; k < 4; ++k) {
+      const int v = mesh.T(wt, k);
+      wtP[k] = pos(v);
+      if (v == n) wtK = k;
+    }
+    auto wtQAt = [&](const Vec3& y) {
+      switch (wtK) {
+        case 0: return radiusRatioOriented(y, wtP[1], wtP[2], wtP[3]);
+        case 1: return radiusRatioOriented(wtP[0], y, wtP[2], wtP[3]);
+        case 2: return radiusRatioOriented(wtP[0], wtP[1], y, wtP[3]);
+        case 3: return radiusRatioOriented(wtP[0], wtP[1], wtP[2], y);
+        default: return radiusRatioOriented(wtP[0], wtP[1], wtP[2], wtP[3]);  // (n not a corner: not expected)
+      }
+    };
+    // Gradient of the worst element's q* (central differences).
+    Vec3 grad = Vec3::Zero();
+    const double fd = 1e-4 * h;
+    for (int a = 0; a < 3; ++a) {
+      Vec3 e = Vec3::Zero();
+      e[a] = fd;
+      grad[a] = (wtQAt(x + e) - wtQAt(x - e)) / (2 * fd);
+    }
+    grad = unitIn(grad);
+    // Push: away from the face opposite n in its worst tet.
+    Vec3 face[3];
+    int f = 0;
+    for (int k = 0; k < 4; ++k)
+      if (mesh.T(wt, k) != n) face[f++] = pos(mesh.T(wt, k));
+    Vec3 push = (face[1] - face[0]).cross(face[2] - face[0]);
+    if (push.norm() > 0) push.normalize();
+    if (push.dot(x - face[0]) < 0) push = -push;
+    push = unitIn(push);
+    const Vec3 spring = options.step_gain * 2.0 * force / deg;
+    const Vec3 dirs[3] = {0.25 * h * grad, spring.norm() * unitIn(spring), 0.3 * h * push};
+    double best = before, bestDv = 0;
+    Vec3 bestX = x;
+    // Every candidate lies within 2 x the longest direction of x (a fan's nearest point is
+    // no farther from y than x is). When the cut surface is farther than that from x (with a
+    // margin of a few eps), no candidate can cross it or come within eps of it: sideKept
+    // holds for all of them, and its surface queries are skipped (one query, asked when the
+    // first candidate gets that far, instead).
+    // y := its nearest point of the cut, which lies within |y - x| + dist(x) of y: the
+    // search looks no farther (the same point as a full search).
+    auto onCutAgain = [&](Vec3& y) {
+      const double r = (y - x).norm() + nodeDistance(n, nullptr, onCut[n] ? region.eps : std::numeric_limits<double>::infinity(), lane);
+      region.surface->signedDistanceNear(Vec3(y), r, &y);
+    };
+    int farFromCut = curved && !onCut[n] ? -1 : 0;  // -1: not asked yet
+    L.starVolume.clear();
+    auto sideOk = [&](const Vec3& y) {
+      if (farFromCut < 0) {
+        double reach = 0;
+        for (const Vec3& d : dirs) reach = std::max(reach, d.norm());
+        farFromCut = nodeWithin(n, 2.0 * reach + 4.0 * region.eps, lane) ? 0 : 1;
+      }
+      return farFromCut == 1 || sideKept(n, x, y);
+    };
+    for (const Vec3& d : dirs) {
+      if (d.squaredNorm() == 0) continue;
+      double step = 1.0;
+      for (int tries = 0; tries < 5; ++tries, step *= 0.5) {
+        Vec3 y = x + step * d;
+        if (c.kind == Freedom::Surface) onCutAgain(y);
+        if (c.kind == Freedom::Ridge) {  // along the ridge edge nearest the move, at most 0.45 of it
+          const Vec3 d = y - x;
+          double bestAlong = 0;
+          Vec3 to = x;
+          for (const Vec3& r : c.ridge) {
+            const Vec3 e = r - x;
+            const double len = e.norm();
+            if (!(len > 0)) continue;
+            const double along = std::min(d.dot(e) / len, 0.45 * len);
+            if (along > bestAlong) {
+              bestAlong = along;
+              to = x + (along / len) * e;
+            }
+          }
+          if (!(bestAlong > 0)) continue;
+          y = to;
+          if (onCut[n]) onCutAgain(y);
+        }
+        if (c.kind == Freedom::Fan) {
+          Vec3 best = y;
+          double bestD = std::numeric_limits<double>::infinity();
+          for (const auto& tri : consLane[lane].fan) {
+            const Vec3 z = closestPointOnTriangle(y, tri[0], tri[1], tri[2]);
+            const double dz = (z - y).squaredNorm();
+            if (dz < bestD) {
+              bestD = dz;
+              best = z;
+            }
+          }
+          y = best;
+        }
+        // The checks below must all pass and have no side effects on the outcome (their
+        // caches and starAbove's lastBelow only skip or order work), so any order gives the
+        // same moves: the cheapest first (the worst tet, which starAbove tries first anyway),
+        // then the volume check (it fails often), the surface queries after it.
+        const double qFirst = wtQAt(y);
+        if (!(qFirst > best)) continue;
+        // Moves on a curved surface change the volume a little (the faces are chords): within the budget.
+        double dv = 0;
+        if (curved && (c.kind == Freedom::Surface || c.kind == Freedom::Fan || c.kind == Freedom::Ridge)) {
+          if (L.starVolume.empty()) {  // the star's volumes where n is (the same for every candidate)
+            // With them, per live star tet the parts of its volume expression that do not
+            // depend on n's position (the corners, the differences and the cross product of
+            // the fixed corners: the same operations on the same values as below).
+            const double* cx = mesh.X.col(0).data();
+            const double* cy = mesh.X.col(1).data();
+            const double* cz = mesh.X.col(2).data();
+            L.starVol.clear();
+            for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s) {
+              L.starVolume.push_back((*dead)[*s] ? 0.0 : tetVolumeHere(mesh, *s));
+              if ((*dead)[*s]) continue;
+              StarVolTet sv;
+              double px[4], py[4], pz[4];
+              sv.kn = -1;
+              for (int k = 0; k < 4; ++k) {
+                const int v = mesh.T(*s, k);
+                if (v == n && sv.kn < 0) sv.kn = k;
+                px[k] = cx[v];
+                py[k] = cy[v];
+                pz[k] = cz[v];
+              }
+              sv.old = L.starVolume.back();
+              for (int k = 0; k < 4; ++k) {
+                sv.p[0][k] = px[k];
+                sv.p[1][k] = py[k];
+                sv.p[2][k] = pz[k];
+              }
+              if (sv.kn != 0) {
+                sv.a[0] = px[1] - px[0], sv.a[1] = py[1] - py[0], sv.a[2] = pz[1] - pz[0];
+                sv.b[0] = px[2] - px[0], sv.b[1] = py[2] - py[0], sv.b[2] = pz[2] - pz[0];
+                sv.e[0] = px[3] - px[0], sv.e[1] = py[3] - py[0], sv.e[2] = pz[3] - pz[0];
+                const double bx = sv.b[0], by = sv.b[1], bz = sv.b[2];
+                const double ex = sv.e[0], ey = sv.e[1], ez = sv.e[2];
+                sv.nrm[0] = by * ez - bz * ey, sv.nrm[1] = bz * ex - bx * ez, sv.nrm[2] = bx * ey - by * ex;
+              }
+              L.starVol.push_back(sv);
+            }
+          }
+          // (The volume of each tet with n at y in scalars, as tetVolumeHere: the same value
+          // as the vector expression (p1 - p0).dot((p2 - p0).cross(p3 - p0)).)
+          for (const StarVolTet& sv : L.starVol) {
+            double ax, ay, az, bx, by, bz, ex, ey, ez, vol6;
+            if (sv.kn == 0) {
+              ax = sv.p[0][1] - y[0], ay = sv.p[1][1] - y[1], az = sv.p[2][1] - y[2];
+              bx = sv.p[0][2] - y[0], by = sv.p[1][2] - y[1], bz = sv.p[2][2] - y[2];
+              ex = sv.p[0][3] - y[0], ey = sv.p[1][3] - y[1], ez = sv.p[2][3] - y[2];
+            } else {
+              ax = sv.a[0], ay = sv.a[1], az = sv.a[2];
+              bx = sv.b[0], by = sv.b[1], bz = sv.b[2];
+              ex = sv.e[0], ey = sv.e[1], ez = sv.e[2];
+              const double dx = y[0] - sv.p[0][0], dy = y[1] - sv.p[1][0], dz = y[2] - sv.p[2][0];
+              if (sv.kn == 1) ax = dx, ay = dy, az = dz;
+              else if (sv.kn == 2) bx = dx, by = dy, bz = dz;
+              else if (sv.kn == 3) ex = dx, ey = dy, ez = dz;
+            }
+            if (sv.kn == 1 || sv.kn < 0) {  // (kn < 0: n not a corner, not expected)
+              vol6 = (ax * sv.nrm[0] + ay * sv.nrm[1]) + az * sv.nrm[2];
+            } else {
+              const double nx = by * ez - bz * ey, ny = bz * ex - bx * ez, nz = bx * ey - by * ex;
+              vol6 = (ax * nx + ay * ny) + az * nz;
+            }
+#ifdef HYSIM_CHECK_EXACT
+            {
+              Vec3 p[4];
+              for (int k = 0; k < 4; ++k)
+                p[k] = k == sv.kn ? y : Vec3(sv.p[0][k], sv.p[1][k], sv.p[2][k]);
+              const double ref = (p[1] - p[0]).dot((p[2] - p[0]).cross(p[3] - p[0]));
+              if (std::memcmp(&ref, &vol6, sizeof vol6) != 0) std::abort();
+            }
+#endif
+            dv += vol6 / 6.0 - sv.old;
+          }
+          if (!moveFits(L, dv) || std::abs(dv) > options.move_volume_fraction * edgeTet) continue;
+        }
+        if (!sideOk(y)) continue;
+        double q = 0;
+        if (starAbove(n, y, wt, qFirst, best, &q)) {
+          best = q;
+          bestX = y;
+          bestDv = dv;
+          break;
+        }
+      }
+    }
+    if (best > before) {
+      L.largest = std::max(L.largest, (bestX - x).norm());
+      if (L.split) {
+        L.net += bestDv;
+        L.churn += std::abs(bestDv);
+        mesh.X.row(n) = bestX.transpose();
+        nodeVer[n] = L.nextVer;
+        L.nextVer += 2;
+      } else {
+        moveBudget.spend(bestDv);
+        setPos(n, bestX);
+      }
+      didMove[n] = 1;
+      L.moved.push_back(n);
+    }
+  };
+  // The move loop's nodes, in parts that can move side by side: after splitWork(list),
+  // partA and partB (each in list order) have no two nodes that are neighbours (share a tet),
+  // so neither part's moves read a position the other's write, and partS holds the rest. A
+  // sort along an axis by position puts the nodes ranked below k on the left; partA is those
+  // whose neighbours in the list are all on the left too, partB the right, partS the left
+  // ones with a neighbour on the right. k makes max(|A|, |B|) + |S| smallest.
+  // False where the list is too short to be worth it or no split leaves both parts nodes.
+  std::vector<std::int32_t> workAt(N, -1);  // place in the list being split, -1 elsewhere
+  // Per node looked at: its neighbours, ringLen[n] entries of ringPool from ringStart[n] (-1: not yet).
+  std::vector<std::int32_t> ringStart(N, -1), ringLen(N, 0), ringMark(N, -1), ringPool;
+  std::vector<std::int32_t> adjOff, adj, rankOf, reach, below, partA, partB, partS;
+  std::vector<std::pair<double, std::int32_t>> keyed;  // (coordinate, place in the list)
+  auto splitWork = [&](const std::vector<std::int32_t>& list) {
+    const int W = static_cast<int>(list.size());
+    if (W < options.parallel_min_nodes) return false;
+    for (int i = 0; i < W; ++i) workAt[list[i]] = i;
+    adjOff.assign(W + 1, 0);
+    adj.clear();
+    for (int i = 0; i < W; ++i) {
+      const int n = list[i];
+      if (ringStart[n] < 0) {  // n's neighbours (live tets), kept: the loop changes no tet
+        ringStart[n] = static_cast<std::int32_t>(ringPool.size());
+        for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s) {
+          if ((*dead)[*s]) continue;
+          for (int k = 0; k < 4; ++k) {
+            const int m = mesh.T(*s, k);
+            if (m == n || ringMark[m] == n) continue;
+            ringMark[m] = n;
+            ringPool.push_back(m);
+          }
+        }
+        ringLen[n] = static_cast<std::int32_t>(ringPool.size()) - ringStart[n];
+      }
+      for (const std::int32_t *m = &ringPool[ringStart[n]], *mEnd = m + ringLen[n]; m < mEnd; ++m)
+        if (workAt[*m] >= 0) adj.push_back(workAt[*m]);
+      adjOff[i + 1] = static_cast<std::int32_t>(adj.size());
+    }
+    for (int n : list) workAt[n] = -1;
+    // The axis: the longest side of the nodes' bounding box.
+    Vec3 lo = pos(list[0]), hi = lo;
+    for (int n : list) {
+      lo = lo.cwiseMin(pos(n));
+      hi = hi.cwiseMax(pos(n));
+    }
+    int axis = 0;
+    (hi - lo).maxCoeff(&axis);
+    keyed.resize(W);
+    for (int i = 0; i < W; ++i) keyed[i] = {mesh.X(list[i], axis), i};
+    std::sort(keyed.begin(), keyed.end());
+    rankOf.resize(W);
+    reach.resize(W);
+    for (int r = 0; r < W; ++r) rankOf[keyed[r].second] = r;
+    for (int i = 0; i < W; ++i) {  // the highest rank of a node and its neighbours
+      reach[i] = rankOf[i];
+      for (int j = adjOff[i]; j < adjOff[i + 1]; ++j) reach[i] = std::max(reach[i], rankOf[adj[j]]);
+    }
+    below.assign(W + 1, 0);  // below[k]: nodes with reach < k (partA's size at k)
+    for (int i = 0; i < W; ++i) ++below[reach[i] + 1];
+    for (int k = 0; k < W; ++k) below[k + 1] += below[k];
+    int bestK = -1, bestCost = W;
+    for (int k = 1; k < W; ++k) {
+      const int sizeA = below[k], sizeB = W - k, sizeS = k - sizeA;
+      const int cost = std::max(sizeA, sizeB) + sizeS;
+      if (sizeA > 0 && cost < bestCost) {
+        bestCost = cost;
+        bestK = k;
+      }
+    }
+    if (bestK < 0) return false;
+    partA.clear();
+    partB.clear();
+    partS.clear();
+    for (int i = 0; i < W; ++i) {
+      if (rankOf[i] >= bestK) {
+        partB.push_back(list[i]);
+      } else if (reach[i] < bestK) {
+        partA.push_back(list[i]);
+      } else {
+        partS.push_back(list[i]);
+      }
+    }
+    return true;
+  };
+  // Moves the nodes of `list` (no repeats), appending the moved ones to movedNow: parts A and B
+  // side by side (B on region.beside's thread where given), then the rest the same way, and
+  // the last part (too short to split) one node after another. The result is that of moving
+  // A, then B, then the rest in order, whichever thread ran what: the parts share no
+  // neighbours and each has half the move budget left at its start (moveFits).
+  std::vector<std::int32_t> moveRest;
+  auto moveRun = [&](const std::vector<std::int32_t>& list) {
+    moveRest = list;
+    while (splitWork(moveRest)) {
+      lanesApart = true;
+      for (int k = 0; k < 2; ++k) {
+        MoveLane& L = moveLane[k];
+        L.split = true;
+        L.net = L.churn = 0;
+        L.moved.clear();
+        L.nextVer = verClock + 1 + static_cast<std::uint32_t>(k);  // lane 0 odd, lane 1 even steps from here
+      }
+      auto runB = [&] {
+        for (int n : partB) moveNode(n, 1);
+      };
+      if (region.beside) {
+        const std::function<void()> wait = region.beside(runB);
+        for (int n : partA) moveNode(n, 0);
+        wait();
+      } else {
+        for (int n : partA) moveNode(n, 0);
+        runB();
+      }
+      lanesApart = false;
+      for (MoveLane& L : moveLane) {
+        L.split = false;
+        moveBudget.net += L.net;
+        moveBudget.churn += L.churn;
+        movedNow.insert(movedNow.end(), L.moved.begin(), L.moved.end());
+        verClock = std::max(verClock, L.nextVer);
+      }
+      moveRest.swap(partS);
+    }
+    moveLane[0].moved.clear();
+    for (int n : moveRest) moveNode(n, 0);
+    movedNow.insert(movedNow.end(), moveLane[0].moved.begin(), moveLane[0].moved.end());
+  };
   int it = 0;
   bfStart.assign(N, -1);  // constraintOf keeps the boundary faces per node (see there)
   bfLen.assign(N, 0);
-  bfPool.clear();
+  bfLane.assign(N, 0);
+  for (ConsLane& cl : consLane) cl.bfPool.clear();
+  consLane[1].localId.assign(N, -1);
+  if (region.surface != nullptr) distInit();  // (the lanes' nodeDistance, nodeWithin)
   for (; it < options.max_iterations && !work.empty(); ++it) {
-    double largest = 0, scale = 0;
+    for (MoveLane& L : moveLane) L.largest = L.scale = 0;
     movedNow.clear();
-    for (int n : work) {
-      // (The cached quality test before the constraint, which looks at the whole star.)
-      int wt = -1;
-      const double before = starWorst(n, &wt);
-      if (before < 0 || before >= options.quality_target || wt < 0) continue;
-      const Constraint c = constraintOf(n);
-      if (c.kind == Freedom::Fixed) continue;
-      const Vec3 x = pos(n);
-      auto project = [&](Vec3 d) {
-        if (c.kind != Freedom::Free && c.kind != Freedom::Ridge) d -= d.dot(c.normal) * c.normal;
-        return d;
-      };
-      // Unit direction of the allowed part of d (zero when d is (nearly) all normal: the
-      // remainder would be rounding noise).
-      auto unitIn = [&](const Vec3& d) {
-        const Vec3 p = project(d);
-        const double len = p.norm();
-        return len > 1e-6 * d.norm() && len > 0 ? Vec3(project(p / len)) : Vec3::Zero();
-      };
-      double sum = 0;
-      int deg = 0;
-      Vec3 force = Vec3::Zero();
-      for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s) {
-        if ((*dead)[(*s)]) continue;
-        for (int k = 0; k < 4; ++k) {
-          const int m = mesh.T((*s), k);
-          if (m == n) continue;
-          sum += (pos(m) - x).norm();
-          ++deg;
-        }
-      }
-      if (deg == 0) continue;
-      const double h = sum / deg;
-      scale = std::max(scale, h);
-      for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s) {
-        if ((*dead)[(*s)]) continue;
-        for (int k = 0; k < 4; ++k) {
-          const int m = mesh.T((*s), k);
-          if (m == n) continue;
-          const Vec3 d = pos(m) - x;
-          const double len = d.norm();
-          if (len > 0) force += (len - h) * d / len;
-        }
-      }
-      // The worst tet's corners, n's at wtK (for tetQAt(wt, n, y) below: the same values).
-      Vec3 wtP[4];
-      int wtK = -1;
-      for (int k = 0; k < 4; ++k) {
-        const int v = mesh.T(wt, k);
-        wtP[k] = pos(v);
-        if (v == n) wtK = k;
-      }
-      auto wtQAt = [&](const Vec3& y) {
-        switch (wtK) {
-          case 0: return radiusRatioOriented(y, wtP[1], wtP[2], wtP[3]);
-          case 1: return radiusRatioOriented(wtP[0], y, wtP[2], wtP[3]);
-          case 2: return radiusRatioOriented(wtP[0], wtP[1], y, wtP[3]);
-          case 3: return radiusRatioOriented(wtP[0], wtP[1], wtP[2], y);
-          default: return radiusRatioOriented(wtP[0], wtP[1], wtP[2], wtP[3]);  // (n not a corner: not expected)
-        }
-      };
-      // Gradient of the worst element's q* (central differences).
-      Vec3 grad = Vec3::Zero();
-      const double fd = 1e-4 * h;
-      for (int a = 0; a < 3; ++a) {
-        Vec3 e = Vec3::Zero();
-        e[a] = fd;
-        grad[a] = (wtQAt(x + e) - wtQAt(x - e)) / (2 * fd);
-      }
-      grad = unitIn(grad);
-      // Push: away from the face opposite n in its worst tet.
-      Vec3 face[3];
-      int f = 0;
-      for (int k = 0; k < 4; ++k)
-        if (mesh.T(wt, k) != n) face[f++] = pos(mesh.T(wt, k));
-      Vec3 push = (face[1] - face[0]).cross(face[2] - face[0]);
-      if (push.norm() > 0) push.normalize();
-      if (push.dot(x - face[0]) < 0) push = -push;
-      push = unitIn(push);
-      const Vec3 spring = options.step_gain * 2.0 * force / deg;
-      const Vec3 dirs[3] = {0.25 * h * grad, spring.norm() * unitIn(spring), 0.3 * h * push};
-      double best = before, bestDv = 0;
-      Vec3 bestX = x;
-      // Every candidate lies within 2 x the longest direction of x (a fan's nearest point is
-      // no farther from y than x is). When the cut surface is farther than that from x (with a
-      // margin of a few eps), no candidate can cross it or come within eps of it: sideKept
-      // holds for all of them, and its surface queries are skipped (one query, asked when the
-      // first candidate gets that far, instead).
-      // y := its nearest point of the cut, which lies within |y - x| + dist(x) of y: the
-      // search looks no farther (the same point as a full search).
-      auto onCutAgain = [&](Vec3& y) {
-        const double r = (y - x).norm() + nodeDistance(n, nullptr, onCut[n] ? region.eps : std::numeric_limits<double>::infinity());
-        region.surface->signedDistanceNear(Vec3(y), r, &y);
-      };
-      int farFromCut = curved && !onCut[n] ? -1 : 0;  // -1: not asked yet
-      starVolume.clear();
-      auto sideOk = [&](const Vec3& y) {
-        if (farFromCut < 0) {
-          double reach = 0;
-          for (const Vec3& d : dirs) reach = std::max(reach, d.norm());
-          farFromCut = nodeWithin(n, 2.0 * reach + 4.0 * region.eps) ? 0 : 1;
-        }
-        return farFromCut == 1 || sideKept(n, x, y);
-      };
-      for (const Vec3& d : dirs) {
-        if (d.squaredNorm() == 0) continue;
-        double step = 1.0;
-        for (int tries = 0; tries < 5; ++tries, step *= 0.5) {
-          Vec3 y = x + step * d;
-          if (c.kind == Freedom::Surface) onCutAgain(y);
-          if (c.kind == Freedom::Ridge) {  // along the ridge edge nearest the move, at most 0.45 of it
-            const Vec3 d = y - x;
-            double bestAlong = 0;
-            Vec3 to = x;
-            for (const Vec3& r : c.ridge) {
-              const Vec3 e = r - x;
-              const double len = e.norm();
-              if (!(len > 0)) continue;
-              const double along = std::min(d.dot(e) / len, 0.45 * len);
-              if (along > bestAlong) {
-                bestAlong = along;
-                to = x + (along / len) * e;
-              }
-            }
-            if (!(bestAlong > 0)) continue;
-            y = to;
-            if (onCut[n]) onCutAgain(y);
-          }
-          if (c.kind == Freedom::Fan) {
-            Vec3 best = y;
-            double bestD = std::numeric_limits<double>::infinity();
-            for (const auto& tri : fan) {
-              const Vec3 z = closestPointOnTriangle(y, tri[0], tri[1], tri[2]);
-              const double dz = (z - y).squaredNorm();
-              if (dz < bestD) {
-                bestD = dz;
-                best = z;
-              }
-            }
-            y = best;
-          }
-          // The checks below must all pass and have no side effects on the outcome (their
-          // caches and starAbove's lastBelow only skip or order work), so any order gives the
-          // same moves: the cheapest first (the worst tet, which starAbove tries first anyway),
-          // then the volume check (it fails often), the surface queries after it.
-          const double qFirst = wtQAt(y);
-          if (!(qFirst > best)) continue;
-          // Moves on a curved surface change the volume a little (the faces are chords): within the budget.
-          double dv = 0;
-          if (curved && (c.kind == Freedom::Surface || c.kind == Freedom::Fan || c.kind == Freedom::Ridge)) {
-            if (starVolume.empty()) {  // the star's volumes where n is (the same for every candidate)
-              // With them, per live star tet the parts of its volume expression that do not
-              // depend on n's position (the corners, the differences and the cross product of
-              // the fixed corners: the same operations on the same values as below).
-              const double* cx = mesh.X.col(0).data();
-              const double* cy = mesh.X.col(1).data();
-              const double* cz = mesh.X.col(2).data();
-              starVol.clear();
-              for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s) {
-                starVolume.push_back((*dead)[*s] ? 0.0 : tetVolumeHere(mesh, *s));
-                if ((*dead)[*s]) continue;
-                StarVolTet sv;
-                double px[4], py[4], pz[4];
-                sv.kn = -1;
-                for (int k = 0; k < 4; ++k) {
-                  const int v = mesh.T(*s, k);
-                  if (v == n && sv.kn < 0) sv.kn = k;
-                  px[k] = cx[v];
-                  py[k] = cy[v];
-                  pz[k] = cz[v];
-                }
-                sv.old = starVolume.back();
-                for (int k = 0; k < 4; ++k) {
-                  sv.p[0][k] = px[k];
-                  sv.p[1][k] = py[k];
-                  sv.p[2][k] = pz[k];
-                }
-                if (sv.kn != 0) {
-                  sv.a[0] = px[1] - px[0], sv.a[1] = py[1] - py[0], sv.a[2] = pz[1] - pz[0];
-                  sv.b[0] = px[2] - px[0], sv.b[1] = py[2] - py[0], sv.b[2] = pz[2] - pz[0];
-                  sv.e[0] = px[3] - px[0], sv.e[1] = py[3] - py[0], sv.e[2] = pz[3] - pz[0];
-                  const double bx = sv.b[0], by = sv.b[1], bz = sv.b[2];
-                  const double ex = sv.e[0], ey = sv.e[1], ez = sv.e[2];
-                  sv.nrm[0] = by * ez - bz * ey, sv.nrm[1] = bz * ex - bx * ez, sv.nrm[2] = bx * ey - by * ex;
-                }
-                starVol.push_back(sv);
-              }
-            }
-            // (The volume of each tet with n at y in scalars, as tetVolumeHere: the same value
-            // as the vector expression (p1 - p0).dot((p2 - p0).cross(p3 - p0)).)
-            for (const StarVolTet& sv : starVol) {
-              double ax, ay, az, bx, by, bz, ex, ey, ez, vol6;
-              if (sv.kn == 0) {
-                ax = sv.p[0][1] - y[0], ay = sv.p[1][1] - y[1], az = sv.p[2][1] - y[2];
-                bx = sv.p[0][2] - y[0], by = sv.p[1][2] - y[1], bz = sv.p[2][2] - y[2];
-                ex = sv.p[0][3] - y[0], ey = sv.p[1][3] - y[1], ez = sv.p[2][3] - y[2];
-              } else {
-                ax = sv.a[0], ay = sv.a[1], az = sv.a[2];
-                bx = sv.b[0], by = sv.b[1], bz = sv.b[2];
-                ex = sv.e[0], ey = sv.e[1], ez = sv.e[2];
-                const double dx = y[0] - sv.p[0][0], dy = y[1] - sv.p[1][0], dz = y[2] - sv.p[2][0];
-                if (sv.kn == 1) ax = dx, ay = dy, az = dz;
-                else if (sv.kn == 2) bx = dx, by = dy, bz = dz;
-                else if (sv.kn == 3) ex = dx, ey = dy, ez = dz;
-              }
-              if (sv.kn == 1 || sv.kn < 0) {  // (kn < 0: n not a corner, not expected)
-                vol6 = (ax * sv.nrm[0] + ay * sv.nrm[1]) + az * sv.nrm[2];
-              } else {
-                const double nx = by * ez - bz * ey, ny = bz * ex - bx * ez, nz = bx * ey - by * ex;
-                vol6 = (ax * nx + ay * ny) + az * nz;
-              }
-#ifdef HYSIM_CHECK_EXACT
-              {
-                Vec3 p[4];
-                for (int k = 0; k < 4; ++k)
-                  p[k] = k == sv.kn ? y : Vec3(sv.p[0][k], sv.p[1][k], sv.p[2][k]);
-                const double ref = (p[1] - p[0]).dot((p[2] - p[0]).cross(p[3] - p[0]));
-                if (std::memcmp(&ref, &vol6, sizeof vol6) != 0) std::abort();
-              }
-#endif
-              dv += vol6 / 6.0 - sv.old;
-            }
-            if (!moveBudget.fits(dv) || std::abs(dv) > options.move_volume_fraction * edgeTet) continue;
-          }
-          if (!sideOk(y)) continue;
-          double q = 0;
-          if (starAbove(n, y, wt, qFirst, best, &q)) {
-            best = q;
-            bestX = y;
-            bestDv = dv;
-            break;
-          }
-        }
-      }
-      if (best > before) {
-        moveBudget.spend(bestDv);
-        largest = std::max(largest, (bestX - x).norm());
-        setPos(n, bestX);
-        didMove[n] = 1;
-        movedNow.push_back(n);
-      }
-    }
+    moveRun(work);
+    const double largest = std::max(moveLane[0].largest, moveLane[1].largest);
+    const double scale = std::max(moveLane[0].scale, moveLane[1].scale);
     work.clear();
     for (int n : movedNow) addBadAround(n, it + 1);
     if (largest <= options.stop_fraction * scale) {

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <bit>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <new>
 #include <utility>
@@ -74,6 +75,8 @@ struct CutRegion {
   // Optional (#T): tets left as they are (pieces the cut cut off), as if already removed:
   // no operation reads or changes them. They start marked in *dead (the caller unmarks them).
   const std::vector<std::uint8_t>* left_alone = nullptr;
+  // Optional: Cut3DOptions::beside, for the move loop's second lane.
+  std::function<std::function<void()>(std::function<void()>)> beside;
 };
 
 struct OptimizeCounts {

@@ -11,6 +11,7 @@
 #include <cmath>
 #include <condition_variable>
 #include <cstdio>
+#include <deque>
 #include <functional>
 #include <limits>
 #include <mutex>
@@ -745,15 +746,13 @@ void Simulation::finishPass() {
   }
   cutting::Cut3DOptions options;
   options.method = cutting::CutMethod::Hybrid;
-  // cut3d's work beside (its node -> tets lists) goes to the worker too.
-  std::function<void()> beside_job;
-  options.beside = [&worker, &beside_job](std::function<void()> job) -> std::function<void()> {
-    if (beside_job) {  // one job at a time in beside_job: a second runs here
-      job();
-      return [] {};
-    }
-    beside_job = std::move(job);
-    const std::int64_t ticket = worker.post(beside_job);
+  // cut3d's work beside (its node -> tets lists, half of each move iteration of the
+  // optimisation) goes to the worker too. (The jobs stay where they are until the pass ends:
+  // the worker runs them from there.)
+  std::deque<std::function<void()>> beside_jobs;
+  options.beside = [&worker, &beside_jobs](std::function<void()> job) -> std::function<void()> {
+    beside_jobs.push_back(std::move(job));
+    const std::int64_t ticket = worker.post(beside_jobs.back());
     return [&worker, ticket] { worker.wait(ticket); };
   };
   // chips.optimize false: the pieces the cut cuts off (chips, removed below) are not

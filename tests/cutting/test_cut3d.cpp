@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <limits>
 #include <random>
+#include <deque>
 #include <thread>
 
 #include "box_mesh.hpp"
@@ -244,14 +245,20 @@ TEST(Cut3D, RepeatedCutAtSamePlaceIsNoOp) {
   }
 }
 
+// The first cut keeps the box's volume exactly (its moves and snaps stay in flat faces); the
+// later ones cross the earlier cuts' faces, where late snaps, collapses and ridge slides may
+// change it within the optimisation's volume_budget (5e-4 of the mesh per cut): here up to
+// 6.3e-5, 6.7e-5 in all (the acceptance for plane cuts: 0.1%).
 TEST(Cut3D, SuccessiveParallelCuts) {
   TetMesh m = testing::boxTetMesh(4, 4, 4, 1.0);
   const double v0 = totalVolume(m);
+  const double budget = Optimize3DOptions{}.volume_budget;
   for (int i = 0; i < 6; ++i) {
-    const auto r = cutAndCheck(m, Vec3(0, 0, 0.37 + 0.55 * i), Vec3(0.05, 0.02, 1), withMethod(CutMethod::Hybrid));
+    const auto r = cutAndCheck(m, Vec3(0, 0, 0.37 + 0.55 * i), Vec3(0.05, 0.02, 1), withMethod(CutMethod::Hybrid),
+                               i == 0 ? 1e-9 : budget);
     m = r.mesh;
   }
-  EXPECT_NEAR(totalVolume(m), v0, 1e-9 * v0);
+  EXPECT_NEAR(totalVolume(m), v0, 1e-3 * v0);
   EXPECT_GE(components(m), 5);
 }
 
@@ -551,20 +558,22 @@ TEST(Cut3D, WorkBesideGivesTheSameCut) {
   ASSERT_TRUE(surface.ok());
   Cut3DOptions here;
   here.method = CutMethod::Hybrid;
+  here.optimize.parallel_min_nodes = 2;  // (every move list that splits does)
   Cut3DOptions beside = here;
   int jobs = 0;
-  std::vector<std::thread> threads;
+  std::deque<std::thread> threads;  // (a deque: the threads stay where they are as it grows)
   beside.beside = [&](std::function<void()> job) -> std::function<void()> {
     ++jobs;
     threads.emplace_back(std::move(job));
     std::thread* t = &threads.back();
     return [t] { t->join(); };
   };
-  threads.reserve(4);
   const auto a = cut3d(box, *surface, here);
   const auto b = cut3d(box, *surface, beside);
   ASSERT_TRUE(a.ok() && b.ok()) << (a.ok() ? b.error() : a.error());
-  EXPECT_EQ(jobs, 1);
+  // The node -> tets lists, and half of the move iterations' nodes (at least once).
+  EXPECT_GE(jobs, 2);
+  const int cutJobs = jobs;
   EXPECT_GT(a->report.cut_faces, 0);
   EXPECT_TRUE(a->mesh.X == b->mesh.X);
   EXPECT_TRUE(a->mesh.T == b->mesh.T);
@@ -576,7 +585,7 @@ TEST(Cut3D, WorkBesideGivesTheSameCut) {
   flat.X.setZero();
   const auto refused = cut3d(flat, *surface, beside);
   EXPECT_FALSE(refused.ok());
-  EXPECT_EQ(jobs, 2);
+  EXPECT_EQ(jobs, cutJobs + 1);
   for (std::thread& t : threads) EXPECT_FALSE(t.joinable());
 }
 
