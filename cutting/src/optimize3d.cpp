@@ -2469,7 +2469,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   std::vector<std::pair<double, std::int32_t>> keyed;  // (coordinate, place in the list)
   auto splitWork = [&](const std::vector<std::int32_t>& list) {
     const int W = static_cast<int>(list.size());
-    if (W < options.parallel_min_nodes) return false;
+    if (W < std::max(2, options.parallel_min_nodes)) return false;
     for (int i = 0; i < W; ++i) workAt[list[i]] = i;
     adjOff.assign(W + 1, 0);
     adj.clear();
@@ -2559,9 +2559,11 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
         for (int n : partB) moveNode(n, 1);
       };
       if (region.beside) {
-        const std::function<void()> wait = region.beside(runB);
+        struct WaitOnExit {  // (part B uses this frame: waited for on every way out)
+          std::function<void()> wait;
+          ~WaitOnExit() { wait(); }
+        } waitB{region.beside(runB)};
         for (int n : partA) moveNode(n, 0);
-        wait();
       } else {
         for (int n : partA) moveNode(n, 0);
         runB();

@@ -246,19 +246,19 @@ TEST(Cut3D, RepeatedCutAtSamePlaceIsNoOp) {
 }
 
 // The first cut keeps the box's volume exactly (its moves and snaps stay in flat faces); the
-// later ones cross the earlier cuts' faces, where late snaps, collapses and ridge slides may
-// change it within the optimisation's volume_budget (5e-4 of the mesh per cut): here up to
-// 6.3e-5, 6.7e-5 in all (the acceptance for plane cuts: 0.1%).
+// later ones cross the earlier cuts' faces, where the cut's snaps sliding along ridges
+// (feature_slide_fraction) and the optimisation's late snaps and collapses (within its
+// volume_budget, 5e-4 of the mesh per cut) may change it: here up to 6.3e-5 per cut, 6.7e-5
+// in all (1e-4 allowed; the acceptance for plane cuts: 0.1%).
 TEST(Cut3D, SuccessiveParallelCuts) {
   TetMesh m = testing::boxTetMesh(4, 4, 4, 1.0);
   const double v0 = totalVolume(m);
-  const double budget = Optimize3DOptions{}.volume_budget;
   for (int i = 0; i < 6; ++i) {
     const auto r = cutAndCheck(m, Vec3(0, 0, 0.37 + 0.55 * i), Vec3(0.05, 0.02, 1), withMethod(CutMethod::Hybrid),
-                               i == 0 ? 1e-9 : budget);
+                               i == 0 ? 1e-9 : 1e-4);
     m = r.mesh;
   }
-  EXPECT_NEAR(totalVolume(m), v0, 1e-3 * v0);
+  EXPECT_NEAR(totalVolume(m), v0, 1e-4 * v0);
   EXPECT_GE(components(m), 5);
 }
 

@@ -71,12 +71,9 @@ struct DumpedPass {
 }
 
 // The flap cases' common acceptance: q*_min of the tissue >= 0.25x the initial mesh's, at most
-// 1.2x the elements, volume kept within volumeTol (3e-4: flaps are thin; the optimisation's
-// volume_budget for peeling and collapses is 5e-4). (2e-4 before the move loop moved its nodes
-// in two parts side by side: in that order pass 52 makes two more collapses, 2.8e-4 against
-// 1.9e-4, and pass 45 one, 2.8e-4 against 2.4e-4.)
+// 1.2x the elements, volume kept within volumeTol (2e-4: flaps are thin).
 constexpr double kInitialQ = 0.1062;  // assets/uterus_myoma.msh
-void expectFlapCaseAccepted(const std::string& name, const DumpedPass& p, double volumeTol = 3e-4) {
+void expectFlapCaseAccepted(const std::string& name, const DumpedPass& p, double volumeTol = 2e-4) {
   std::printf("%s: q*_min %.4f (%.2fx the initial), %d tets in flaps\n", name.c_str(), p.q_kept, p.q_kept / kInitialQ,
               p.out.report.flap_peeled);
   EXPECT_GE(p.q_kept, 0.25 * kInitialQ);
@@ -185,8 +182,10 @@ TEST(ShaveQuality, FlapsAtANodeAlreadyPinchedBeforeThePassArePeeled) {
   EXPECT_GT(p.out.report.flap_peeled, 0);
   // With collapse_material_limit the collapses across the myoma interface that would have
   // repaired some poor tets are refused, and flap peeling takes them instead (21 tets, 18.8
-  // mm3 = 2.4e-4, against 5 tets, 10.5 mm3 without the limit).
-  expectFlapCaseAccepted("pass45", p);
+  // mm3 = 2.4e-4, against 5 tets, 10.5 mm3 without the limit). 3e-4: in the move order of
+  // the split move loop (parallel_min_nodes) one more collapse, 2.8e-4 (the optimisation's
+  // volume_budget for peeling and collapses is 5e-4).
+  expectFlapCaseAccepted("pass45", p, 3e-4);
 }
 
 // The move loop moves its nodes in two parts side by side (Optimize3DOptions::
@@ -213,12 +212,6 @@ TEST(ShaveQuality, MoveLoopPartsOnAnotherThreadGiveTheSameCut) {
     EXPECT_TRUE(here.out.mesh.X == beside.out.mesh.X);
     EXPECT_TRUE(here.out.mesh.T == beside.out.mesh.T);
     EXPECT_EQ(here.out.change.node_old_to_new, beside.out.change.node_old_to_new);
-    // One node after another (parts too short to split) the moves are those of before: another cut.
-    Cut3DOptions serial;
-    serial.optimize.parallel_min_nodes = std::numeric_limits<int>::max();
-    DumpedPass one;
-    ASSERT_TRUE(cutDumpedPass(name, serial, &one));
-    EXPECT_FALSE(one.out.mesh.X.rows() == here.out.mesh.X.rows() && one.out.mesh.X == here.out.mesh.X);
   }
 }
 
@@ -275,7 +268,9 @@ TEST(ShaveQuality, ACollapseNextToANodeAlreadyPinchedBeforeThePassIsKept) {
   DumpedPass p;
   ASSERT_TRUE(cutDumpedPass("pass52", Cut3DOptions{}, &p));
   EXPECT_GT(p.out.report.collapsed_edges, 0);
-  expectFlapCaseAccepted("pass52", p);
+  // 3e-4: in the move order of the split move loop two more collapses, 2.8e-4 (1.9e-4 one
+  // node after another; volume_budget 5e-4).
+  expectFlapCaseAccepted("pass52", p, 3e-4);
 }
 // Passes 49 and 50 of a default-scene-like run (`hysim run ... --dump-cuts DIR` with a
 // different mapping of the sweep, another branch, 2026-11): each leaves one tet (q* 0.0255,
