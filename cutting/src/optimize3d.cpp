@@ -554,7 +554,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     const bool nodeOnCut = onCut[n] != 0;
     // A node on a ridge (the rim, where the cut meets the boundary, or a crease of the
     // boundary) slides along it: exactly two of its boundary edges are ridge edges (between a
-    // cut and a non-cut face, or S.faces more than ridge_deg apart).
+    // cut and a non-cut face, or faces more than ridge_deg apart).
     auto ridgeOf = [&]() {
       if (!curved || !(options.ridge_deg > 0)) return false;
       int found = 0;
@@ -591,7 +591,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       if (!boundary || sum.norm() == 0) return c;
       c.normal = sum.normalized();
       // A curved cut surface: slide in the tangent plane, then back onto the surface (the
-      // volume changes by second-order amounts), where the cut S.faces around are smooth.
+      // volume changes by second-order amounts), where the cut faces around are smooth.
       c.kind = Freedom::Surface;
       for (const auto& bf : S.faces)
         if (bf.unit.dot(c.normal) < cosCurved) c.kind = Freedom::Fixed;
@@ -613,7 +613,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       }
       if (cosine < cosFlat) c.kind = Freedom::Fan;
     }
-    if (c.kind == Freedom::Fan) {  // the node stays on its boundary S.faces as they are now
+    if (c.kind == Freedom::Fan) {  // the node stays on its boundary faces as they are now
       S.fan.clear();
       for (const auto& bf : S.faces) S.fan.push_back({pos(n), pos(bf.u), pos(bf.v)});
     }
