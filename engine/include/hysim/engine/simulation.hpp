@@ -72,7 +72,7 @@ struct PerforationEvent {
   double min_distance_mm = 0.0;  // closest approach of the wire's surface; < 0: beyond the serosa
 };
 
-class PassWorker;  // simulation.cpp
+class PassWorker;  // pass_worker.hpp
 
 class Simulation {
  public:
