@@ -4,17 +4,13 @@
 #include <assimp/scene.h>
 
 #include <algorithm>
-#include <array>
 #include <assimp/Importer.hpp>
-#include <atomic>
 #include <chrono>
 #include <cmath>
-#include <condition_variable>
 #include <cstdio>
 #include <deque>
 #include <functional>
 #include <limits>
-#include <mutex>
 #include <thread>
 
 #include "hysim/cutting/cut3d.hpp"
