@@ -24,7 +24,6 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <deque>
 #include <functional>
 #include <string>
 #include <vector>
@@ -216,14 +215,9 @@ void BM_Cut3DUpdateTwoThreads(benchmark::State& state) {
   }
   const auto surface = planeThrough(p.mesh, plane);
   hysim::engine::PassWorker worker;
-  std::deque<std::function<void()>> jobs;  // (where the worker runs them from)
   hysim::cutting::Cut3DOptions o;
   o.method = CutMethod::Hybrid;
-  o.beside = [&worker, &jobs](std::function<void()> job) -> std::function<void()> {
-    jobs.push_back(std::move(job));
-    const std::int64_t ticket = worker.post(jobs.back());
-    return [&worker, ticket] { worker.wait(ticket); };
-  };
+  o.beside = worker.lend();
   double cutMs = 0, optMs = 0, updMs = 0;
   hysim::sim::Model model;
   std::vector<std::uint8_t> fixed;
@@ -231,7 +225,6 @@ void BM_Cut3DUpdateTwoThreads(benchmark::State& state) {
   for (auto _ : state) {
     state.PauseTiming();
     model = p.model;
-    jobs.clear();
     worker.begin();  // (the simulator wakes it as the pass starts, before the sweep's mapping:
     worker.wait(worker.post(noop));  // not timed here, and running when the cut starts)
     state.ResumeTiming();

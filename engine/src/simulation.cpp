@@ -8,7 +8,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <deque>
 #include <functional>
 #include <limits>
 #include <thread>
@@ -654,14 +653,8 @@ void Simulation::finishPass() {
   cutting::Cut3DOptions options;
   options.method = cutting::CutMethod::Hybrid;
   // cut3d's work beside (its node -> tets lists, half of each move iteration of the
-  // optimisation) goes to the worker too. (The jobs stay where they are until the pass ends:
-  // the worker runs them from there.)
-  std::deque<std::function<void()>> beside_jobs;
-  options.beside = [&worker, &beside_jobs](std::function<void()> job) -> std::function<void()> {
-    beside_jobs.push_back(std::move(job));
-    const std::int64_t ticket = worker.post(beside_jobs.back());
-    return [&worker, ticket] { worker.wait(ticket); };
-  };
+  // optimisation) goes to the worker too.
+  options.beside = worker.lend();
   // chips.optimize false: the pieces the cut cuts off (chips, removed below) are not
   // optimised; cut3d finds them with the anchors used below (the nodes' flags; by position
   // where the cut made, moved or put a node on the cut).

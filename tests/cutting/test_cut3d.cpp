@@ -9,10 +9,10 @@
 #include <filesystem>
 #include <limits>
 #include <random>
-#include <deque>
 #include <thread>
 
 #include "box_mesh.hpp"
+#include "thread_beside.hpp"
 #include "hysim/cutting/cut3d.hpp"
 #include "hysim/cutting/mesh_io.hpp"
 #include "hysim/cutting/mesh_stats.hpp"
@@ -560,20 +560,14 @@ TEST(Cut3D, WorkBesideGivesTheSameCut) {
   here.method = CutMethod::Hybrid;
   here.optimize.parallel_min_nodes = 2;  // (every move list that splits does)
   Cut3DOptions beside = here;
-  int jobs = 0;
-  std::deque<std::thread> threads;  // (a deque: the threads stay where they are as it grows)
-  beside.beside = [&](std::function<void()> job) -> std::function<void()> {
-    ++jobs;
-    threads.emplace_back(std::move(job));
-    std::thread* t = &threads.back();
-    return [t] { t->join(); };
-  };
+  testing::ThreadBeside threads;
+  beside.beside = threads.lend();
   const auto a = cut3d(box, *surface, here);
   const auto b = cut3d(box, *surface, beside);
   ASSERT_TRUE(a.ok() && b.ok()) << (a.ok() ? b.error() : a.error());
   // The node -> tets lists, and half of the move iterations' nodes (at least once).
-  EXPECT_GE(jobs, 2);
-  const int cutJobs = jobs;
+  EXPECT_GE(threads.jobs(), 2);
+  const int cutJobs = threads.jobs();
   EXPECT_GT(a->report.cut_faces, 0);
   EXPECT_TRUE(a->mesh.X == b->mesh.X);
   EXPECT_TRUE(a->mesh.T == b->mesh.T);
@@ -585,8 +579,8 @@ TEST(Cut3D, WorkBesideGivesTheSameCut) {
   flat.X.setZero();
   const auto refused = cut3d(flat, *surface, beside);
   EXPECT_FALSE(refused.ok());
-  EXPECT_EQ(jobs, cutJobs + 1);
-  for (std::thread& t : threads) EXPECT_FALSE(t.joinable());
+  EXPECT_EQ(threads.jobs(), cutJobs + 1);
+  for (std::thread& t : threads.threads) EXPECT_FALSE(t.joinable());
 }
 
 TEST(Cut3D, StripIsTheSameSurfaceAsItsTriangles) {

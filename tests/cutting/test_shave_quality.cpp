@@ -7,16 +7,14 @@
 // nodes were all held: rim, curved boundary, creases); now 0.55x.
 #include <gtest/gtest.h>
 
-#include <deque>
 #include <filesystem>
-#include <functional>
 #include <limits>
 #include <string>
-#include <thread>
 
 #include "hysim/cutting/cut3d.hpp"
 #include "hysim/cutting/mesh_io.hpp"
 #include "hysim/cutting/mesh_stats.hpp"
+#include "thread_beside.hpp"
 
 namespace hysim::cutting {
 namespace {
@@ -198,17 +196,11 @@ TEST(ShaveQuality, MoveLoopPartsOnAnotherThreadGiveTheSameCut) {
     DumpedPass here;
     ASSERT_TRUE(cutDumpedPass(name, Cut3DOptions{}, &here));
     Cut3DOptions options;
-    int jobs = 0;
-    std::deque<std::thread> threads;
-    options.beside = [&](std::function<void()> job) -> std::function<void()> {
-      ++jobs;
-      threads.emplace_back(std::move(job));
-      std::thread* t = &threads.back();
-      return [t] { t->join(); };
-    };
+    testing::ThreadBeside threads;
+    options.beside = threads.lend();
     DumpedPass beside;
     ASSERT_TRUE(cutDumpedPass(name, options, &beside));
-    EXPECT_GT(jobs, 4);  // the node -> tets lists, and move iterations' parts
+    EXPECT_GT(threads.jobs(), 4);  // the node -> tets lists, and move iterations' parts
     EXPECT_TRUE(here.out.mesh.X == beside.out.mesh.X);
     EXPECT_TRUE(here.out.mesh.T == beside.out.mesh.T);
     EXPECT_EQ(here.out.change.node_old_to_new, beside.out.change.node_old_to_new);

@@ -4,6 +4,8 @@
 #include <atomic>
 #include <condition_variable>
 #include <cstdint>
+#include <deque>
+#include <functional>
 #include <mutex>
 #include <thread>
 
@@ -29,6 +31,7 @@ class PassWorker {
     thread_.join();
   }
   void begin() {
+    lent_.clear();  // (every job lent before was waited for)
     {
       std::lock_guard<std::mutex> lock(mutex_);
       awake_.store(true, std::memory_order_release);
@@ -36,6 +39,15 @@ class PassWorker {
     wake_.notify_one();
   }
   void end() { awake_.store(false, std::memory_order_release); }
+  // A Cut3DOptions::beside that runs each job on the worker (kept here until the next
+  // begin(); the caller waits for each, as cut3d does, before end()).
+  std::function<std::function<void()>(std::function<void()>)> lend() {
+    return [this](std::function<void()> job) -> std::function<void()> {
+      lent_.push_back(std::move(job));
+      const std::int64_t ticket = post(lent_.back());
+      return [this, ticket] { wait(ticket); };
+    };
+  }
   // Runs job() on the worker; returns the ticket to wait for.
   template <class F>
   std::int64_t post(F& job) {
@@ -96,6 +108,7 @@ class PassWorker {
   std::mutex mutex_;
   std::condition_variable wake_;
   bool quit_ = false;   // under mutex_
+  std::deque<std::function<void()>> lent_;  // lend()'s jobs (a deque: they stay where they are)
   std::thread thread_;  // last: starts once the members above exist
 };
 
