@@ -11,7 +11,7 @@
 // means), update_cpu_med_ms (BM_Cut3DUpdate: the update's median thread CPU time, steadier
 // than the wall clock on a loaded machine). Medians over the repetitions (the `_median` rows). Run from anywhere:
 //   ./build/bench/bench_cut3d --benchmark_filter='BM_Cut3DUpdate/./././1'   (incremental)
-//   ./build/bench/bench_cut3d --benchmark_filter='BM_Cut3DUpdateTwoThreads'  (as the simulator: two threads)
+//   ./build/bench/bench_cut3d --benchmark_filter='BM_Cut3DUpdateTwoThreads'  (two threads)
 // BM_Cut3DReplay: recorded shaving passes (HYSIM_REPLAY_DIR, see below).
 // BM_Cut3DSurface: the same meshes cut by a curved swept strip (the shaving passes' surfaces):
 //   ./build/bench/bench_cut3d --benchmark_filter='BM_Cut3DSurface'
@@ -201,11 +201,14 @@ BENCHMARK(BM_Cut3DUpdate)
     ->Repetitions(5)
     ->ReportAggregatesOnly(true);
 
-// BM_Cut3DUpdate/m/p/0/1 as the simulator's pass runs it, on two threads: cut3d hands its
-// work beside (its node -> tets lists, half of each move iteration) to a PassWorker, then the
-// update's first part (prepareModelAfterCut3D) runs there while this thread finds the anchored
-// nodes and remaps the state, then its second part here. The same model and state as
-// BM_Cut3DUpdate's (updateModelAfterCut3D is the two parts). Counters as there.
+// BM_Cut3DUpdate/m/p/0/1 on two threads: cut3d hands its work beside (its node -> tets
+// lists, half of each move iteration) to a PassWorker, as the simulator's pass does; then the
+// update's first part (prepareModelAfterCut3D) runs here and lends the worker its element
+// comparison and its springs (CutUpdate3DOptions::beside; the simulator's pass runs this part
+// on the worker while its own thread finds the pieces cut free, so there nothing is lent),
+// then this thread finds the anchored nodes, remaps the state and runs the second part. The
+// same model and state as BM_Cut3DUpdate's (updateModelAfterCut3D is the two parts).
+// Counters as there.
 void BM_Cut3DUpdateTwoThreads(benchmark::State& state) {
   const Prepared& p = mesh(static_cast<int>(state.range(0)));
   const int plane = static_cast<int>(state.range(1));
@@ -218,6 +221,8 @@ void BM_Cut3DUpdateTwoThreads(benchmark::State& state) {
   hysim::cutting::Cut3DOptions o;
   o.method = CutMethod::Hybrid;
   o.beside = worker.lend();
+  hysim::sim::CutUpdate3DOptions update;
+  update.beside = o.beside;
   double cutMs = 0, optMs = 0, updMs = 0;
   hysim::sim::Model model;
   std::vector<std::uint8_t> fixed;
@@ -237,20 +242,16 @@ void BM_Cut3DUpdateTwoThreads(benchmark::State& state) {
       return;
     }
     hysim::sim::CutUpdate3DPrepared prepared;
-    hysim::Status prepareStatus;
-    auto prepare = [&] {
-      prepareStatus = hysim::sim::prepareModelAfterCut3D(model, p.mesh, r->mesh, r->change, {}, &prepared);
-    };
-    const std::int64_t ticket = worker.post(prepare);
+    const hysim::Status prepareStatus =
+        hysim::sim::prepareModelAfterCut3D(model, p.mesh, r->mesh, r->change, update, &prepared);
     fixed.assign(static_cast<size_t>(r->mesh.numNodes()), 0);
     for (int i = 0; i < p.mesh.numNodes(); ++i) {
       const int j = r->change.node_old_to_new[i];
       if (j >= 0) fixed[j] = p.model.fixed[i] ? 1 : 0;
     }
     auto s = hysim::sim::remapState3D(p.state, r->change);
-    worker.wait(ticket);
     const hysim::Status st =
-        prepareStatus.ok() ? hysim::sim::finishModelAfterCut3D(model, r->mesh, r->change, fixed, {}, {}, prepared)
+        prepareStatus.ok() ? hysim::sim::finishModelAfterCut3D(model, r->mesh, r->change, fixed, {}, update, prepared)
                            : prepareStatus;
     const auto t2 = std::chrono::steady_clock::now();
     worker.end();

@@ -564,6 +564,98 @@ Status prepareModelAfterCut3D(const Model& model, const cutting::TetMesh& before
   const std::vector<std::int32_t>& o2n = change.node_old_to_new;
   CutUpdate3DReport& rep = prepared->report;
   rep.omega_previous = model.omega_max;
+  const int T0 = before.numTets();
+  if (static_cast<int>(change.element_old_to_new.size()) != T0)
+    return Error{"updateModelAfterCut3D: the change's element map does not match the mesh"};
+  // A job handed to options.beside (or run here without one), waited for by join() before its
+  // results are read, and on every way out: each is declared after what its job uses, so it
+  // is waited for before any of that goes.
+  struct Lent {
+    std::function<void()> wait;
+    Lent(const CutUpdate3DOptions& o, const std::function<void()>& job) {
+      if (o.beside) {
+        wait = o.beside(job);
+      } else {
+        job();
+      }
+    }
+    Lent(const Lent&) = delete;
+    Lent& operator=(const Lent&) = delete;
+    void join() {
+      if (wait) {
+        const std::function<void()> w = std::move(wait);
+        wait = nullptr;
+        w();
+      }
+    }
+    ~Lent() { join(); }
+  };
+
+  // Touched nodes: their masses and the springs between them change.
+  std::vector<std::uint8_t> touched(static_cast<size_t>(N1), 0);
+  for (const cutting::NewNode& nn : change.new_nodes)
+    if (nn.id >= 0 && nn.id < N1) touched[nn.id] = 1;
+  for (int i : change.cut_nodes)
+    if (i >= 0 && i < N1) touched[i] = 1;
+  // Elements that are not an old element with the same nodes (added, or renumbered onto a
+  // duplicate by the cut) touch their nodes, and so do the old elements they replace: found
+  // beside the node -> tets lists below (it reads the meshes and the change only, and writes
+  // `touched` and old_of, which nothing else reads until it is done).
+  const std::int32_t* after_col[4] = {after.T.col(0).data(), after.T.col(1).data(), after.T.col(2).data(),
+                                       after.T.col(3).data()};
+  const std::int32_t* before_col[4] = {before.T.col(0).data(), before.T.col(1).data(), before.T.col(2).data(),
+                                        before.T.col(3).data()};
+  std::vector<int> old_of(static_cast<size_t>(T1), -1);
+  const std::function<void()> compareJob = [&] {
+    for (int t = 0; t < T0; ++t) {
+      const int u = change.element_old_to_new[t];
+      if (u >= 0 && u < T1) old_of[u] = t;
+    }
+    auto touchTetHere = [&](int t) {
+      for (int k = 0; k < 4; ++k) touched[after_col[k][t]] = 1;
+    };
+    auto touchOld = [&](int t) {
+      for (int k = 0; k < 4; ++k) {
+        const int j = o2n[before_col[k][t]];
+        if (j >= 0) touched[j] = 1;
+      }
+    };
+    for (int t = 0; t < T0; ++t)
+      if (change.element_old_to_new[t] < 0) touchOld(t);
+    auto compareElement = [&](int t) {
+      const int o = old_of[t];
+      if (o >= 0 && after_col[0][t] == o2n[before_col[0][o]] && after_col[1][t] == o2n[before_col[1][o]] &&
+          after_col[2][t] == o2n[before_col[2][o]] && after_col[3][t] == o2n[before_col[3][o]])
+        return;  // the same nodes in the same order: most elements
+      bool same = o >= 0;
+      if (same) {
+        std::array<int, 4> a{}, b{};
+        for (int k = 0; k < 4; ++k) {
+          a[k] = after_col[k][t];
+          b[k] = o2n[before_col[k][o]];
+        }
+        if (a != b) {  // the same nodes in another order are the same element
+          std::sort(a.begin(), a.end());
+          std::sort(b.begin(), b.end());
+          same = a == b;
+        }
+      }
+      if (!same) {
+        touchTetHere(t);
+        if (o >= 0) touchOld(o);
+      }
+    };
+    if (model.options.simd && lanczosAvx2() && T1 > 0) {
+      // The first test (same nodes in the same order) 4 elements at a time; the others as above.
+      const std::unique_ptr<int[]> candidates(new int[static_cast<size_t>(T1)]);
+      const int num_candidates =
+          sameOrderCandidatesAvx2(T1, old_of.data(), after_col, before_col, o2n.data(), candidates.get());
+      for (int i = 0; i < num_candidates; ++i) compareElement(candidates[i]);
+    } else {
+      for (int t = 0; t < T1; ++t) compareElement(t);
+    }
+  };
+  Lent compare(options, compareJob);
 
   // Material of each tet (written in full below: allocated without a fill).
   const std::unique_ptr<int[]> material_storage(new int[static_cast<size_t>(T1)]);
@@ -622,70 +714,20 @@ Status prepareModelAfterCut3D(const Model& model, const cutting::TetMesh& before
     }
     return volume[t];
   };
+  auto volumeOf = [&](int t) {  // tetVolume without writing the cache (for the springs job)
+    const double v = volume[t];
+    if (!std::isnan(v)) return v;
+    const Eigen::Vector3d x0 = after.X.row(node(t, 0));
+    const Eigen::Vector3d x1 = after.X.row(node(t, 1));
+    const Eigen::Vector3d x2 = after.X.row(node(t, 2));
+    const Eigen::Vector3d x3 = after.X.row(node(t, 3));
+    return (x1 - x0).dot((x2 - x0).cross(x3 - x0)) / 6.0;
+  };
 
-  // Touched nodes: their masses and the springs between them change.
-  std::vector<std::uint8_t> touched(static_cast<size_t>(N1), 0);
+  compare.join();
   auto touchTet = [&](int t) {
     for (int k = 0; k < 4; ++k) touched[node(t, k)] = 1;
   };
-  for (const cutting::NewNode& nn : change.new_nodes)
-    if (nn.id >= 0 && nn.id < N1) touched[nn.id] = 1;
-  for (int i : change.cut_nodes)
-    if (i >= 0 && i < N1) touched[i] = 1;
-  // Elements that are not an old element with the same nodes (added, or renumbered onto a
-  // duplicate by the cut) touch their nodes, and so do the old elements they replace.
-  const int T0 = before.numTets();
-  if (static_cast<int>(change.element_old_to_new.size()) != T0)
-    return Error{"updateModelAfterCut3D: the change's element map does not match the mesh"};
-  std::vector<int> old_of(static_cast<size_t>(T1), -1);
-  for (int t = 0; t < T0; ++t) {
-    const int u = change.element_old_to_new[t];
-    if (u >= 0 && u < T1) old_of[u] = t;
-  }
-  auto touchOld = [&](int t) {
-    for (int k = 0; k < 4; ++k) {
-      const int j = o2n[before.T(t, k)];
-      if (j >= 0) touched[j] = 1;
-    }
-  };
-  for (int t = 0; t < T0; ++t)
-    if (change.element_old_to_new[t] < 0) touchOld(t);
-  const std::int32_t* after_col[4] = {after.T.col(0).data(), after.T.col(1).data(), after.T.col(2).data(),
-                                       after.T.col(3).data()};
-  const std::int32_t* before_col[4] = {before.T.col(0).data(), before.T.col(1).data(), before.T.col(2).data(),
-                                        before.T.col(3).data()};
-  auto compareElement = [&](int t) {
-    const int o = old_of[t];
-    if (o >= 0 && after_col[0][t] == o2n[before_col[0][o]] && after_col[1][t] == o2n[before_col[1][o]] &&
-        after_col[2][t] == o2n[before_col[2][o]] && after_col[3][t] == o2n[before_col[3][o]])
-      return;  // the same nodes in the same order: most elements
-    bool same = o >= 0;
-    if (same) {
-      std::array<int, 4> a{}, b{};
-      for (int k = 0; k < 4; ++k) {
-        a[k] = node(t, k);
-        b[k] = o2n[before.T(o, k)];
-      }
-      if (a != b) {  // the same nodes in another order are the same element
-        std::sort(a.begin(), a.end());
-        std::sort(b.begin(), b.end());
-        same = a == b;
-      }
-    }
-    if (!same) {
-      touchTet(t);
-      if (o >= 0) touchOld(o);
-    }
-  };
-  if (model.options.simd && lanczosAvx2() && T1 > 0) {
-    // The first test (same nodes in the same order) 4 elements at a time; the others as above.
-    const std::unique_ptr<int[]> candidates(new int[static_cast<size_t>(T1)]);
-    const int num_candidates =
-        sameOrderCandidatesAvx2(T1, old_of.data(), after_col, before_col, o2n.data(), candidates.get());
-    for (int i = 0; i < num_candidates; ++i) compareElement(candidates[i]);
-  } else {
-    for (int t = 0; t < T1; ++t) compareElement(t);
-  }
   for (int t : change.added_elements)
     if (t >= 0 && t < T1) touchTet(t);
   for (int i : change.moved_nodes)
@@ -746,6 +788,66 @@ Status prepareModelAfterCut3D(const Model& model, const cutting::TetMesh& before
   }
   for (int j : region_nodes)
     if (mass[j] > 0.0) unknown.push_back(j);
+  // Springs: unchanged unless both ends are touched; edges between touched nodes anew.
+  // The unchanged ones stay in the model's arrays (compacted in place by the second part,
+  // once nothing can fail); `springs` collects the recomputed ones, which follow them.
+  std::vector<CutUpdate3DPrepared::Spring>& springs = prepared->springs;
+  // Per touched node a in increasing order, the edges (a, b) to touched nodes b > a, in
+  // increasing b (buildModel's order), each summing its tets in increasing order (as
+  // buildModel does): a's tet list is in increasing order, so each b's sums are accumulated
+  // in that order, in a small table of a's neighbours (`slot`: b -> entry, -1 otherwise).
+  struct EdgeSum {
+    int b;
+    double ev, bev;
+  };
+  std::vector<EdgeSum> edge_sums;
+  std::vector<int> slot(static_cast<size_t>(N1), -1);
+  // About 7 edges a node towards higher-numbered neighbours in a tet mesh: room for most
+  // cuts without regrowing (each regrowth copies the springs collected so far).
+  int recomputed = 0;
+  Status springs_status;
+  // (Beside the masses' correction: it reads the volumes the lumped priors computed, every tet
+  // around a touched node, and writes only `springs`, recomputed and springs_status.)
+  const std::function<void()> springsJob = [&] {
+    springs.reserve(8 * static_cast<size_t>(rep.touched_nodes));
+    for (int r = 0; r < rep.touched_nodes; ++r) {
+      const int a = region_nodes[r];
+      edge_sums.clear();
+      for (int e = off[a]; e < off[a + 1]; ++e) {
+        const int t = around[e];
+        const Material* mat = nullptr;
+        double vol = 0.0;
+        for (int k = 0; k < 4; ++k) {
+          const int b = node(t, k);
+          if (b <= a || !touched[b]) continue;
+          if (mat == nullptr) {
+            vol = volumeOf(t);
+            if (!(vol > 0.0)) {
+              springs_status = Error{"tet " + std::to_string(t) + " has non-positive volume " + std::to_string(vol)};
+              return;
+            }
+            mat = &model.materials[material[t]];
+          }
+          int& at = slot[b];
+          if (at < 0) {
+            at = static_cast<int>(edge_sums.size());
+            edge_sums.push_back({b, 0.0, 0.0});
+          }
+          EdgeSum& sum = edge_sums[at];
+          sum.ev += mat->young_modulus_pa * vol;
+          sum.bev += mat->stiffness_damping_s * mat->young_modulus_pa * vol;
+        }
+      }
+      for (const EdgeSum& sum : edge_sums) slot[sum.b] = -1;
+      std::sort(edge_sums.begin(), edge_sums.end(), [](const EdgeSum& x, const EdgeSum& y) { return x.b < y.b; });
+      for (const EdgeSum& sum : edge_sums) {
+        const double len = (after.X.row(sum.b) - after.X.row(a)).norm();
+        springs.push_back({a, sum.b, len, sum.ev / (len * len), sum.bev / (len * len)});
+        ++recomputed;
+      }
+    }
+  };
+  Lent springs_lent(options, springsJob);
   if (!unknown.empty()) {
     Eigen::Vector3d lo = after.X.row(unknown[0]).transpose(), hi = lo;
     for (int j : unknown) {
@@ -775,57 +877,8 @@ Status prepareModelAfterCut3D(const Model& model, const cutting::TetMesh& before
   for (int j : region_nodes)
     if (!(mass[j] >= 0.0) || !std::isfinite(mass[j])) return Error{"updateModelAfterCut3D: non-finite or negative mass"};
 
-  // Springs: unchanged unless both ends are touched; edges between touched nodes anew.
-  // The unchanged ones stay in the model's arrays (compacted in place by the second part,
-  // once nothing can fail); `springs` collects the recomputed ones, which follow them.
-  std::vector<CutUpdate3DPrepared::Spring>& springs = prepared->springs;
-  // Per touched node a in increasing order, the edges (a, b) to touched nodes b > a, in
-  // increasing b (buildModel's order), each summing its tets in increasing order (as
-  // buildModel does): a's tet list is in increasing order, so each b's sums are accumulated
-  // in that order, in a small table of a's neighbours (`slot`: b -> entry, -1 otherwise).
-  struct EdgeSum {
-    int b;
-    double ev, bev;
-  };
-  std::vector<EdgeSum> edge_sums;
-  std::vector<int> slot(static_cast<size_t>(N1), -1);
-  // About 7 edges a node towards higher-numbered neighbours in a tet mesh: room for most
-  // cuts without regrowing (each regrowth copies the springs collected so far).
-  springs.reserve(8 * static_cast<size_t>(rep.touched_nodes));
-  int recomputed = 0;
-  for (int r = 0; r < rep.touched_nodes; ++r) {
-    const int a = region_nodes[r];
-    edge_sums.clear();
-    for (int e = off[a]; e < off[a + 1]; ++e) {
-      const int t = around[e];
-      const Material* mat = nullptr;
-      double vol = 0.0;
-      for (int k = 0; k < 4; ++k) {
-        const int b = node(t, k);
-        if (b <= a || !touched[b]) continue;
-        if (mat == nullptr) {
-          vol = tetVolume(t);
-          if (!(vol > 0.0)) return Error{"tet " + std::to_string(t) + " has non-positive volume " + std::to_string(vol)};
-          mat = &model.materials[material[t]];
-        }
-        int& at = slot[b];
-        if (at < 0) {
-          at = static_cast<int>(edge_sums.size());
-          edge_sums.push_back({b, 0.0, 0.0});
-        }
-        EdgeSum& sum = edge_sums[at];
-        sum.ev += mat->young_modulus_pa * vol;
-        sum.bev += mat->stiffness_damping_s * mat->young_modulus_pa * vol;
-      }
-    }
-    for (const EdgeSum& sum : edge_sums) slot[sum.b] = -1;
-    std::sort(edge_sums.begin(), edge_sums.end(), [](const EdgeSum& x, const EdgeSum& y) { return x.b < y.b; });
-    for (const EdgeSum& sum : edge_sums) {
-      const double len = (after.X.row(sum.b) - after.X.row(a)).norm();
-      springs.push_back({a, sum.b, len, sum.ev / (len * len), sum.bev / (len * len)});
-      ++recomputed;
-    }
-  }
+  springs_lent.join();
+  if (!springs_status.ok()) return springs_status;
   rep.springs_recomputed = recomputed;
   prepared->num_nodes_before = N0;
   prepared->mass = std::move(mass);

@@ -7,6 +7,7 @@
 #include <random>
 
 #include "box_mesh.hpp"
+#include "thread_beside.hpp"
 #include "hysim/cutting/cut3d.hpp"
 #include "hysim/sim/tissue_update3d.hpp"
 #include "../../sim/src/model_internal.hpp"  // topTridiagonalEigenvalue
@@ -348,6 +349,84 @@ TEST(TissueUpdate3D, TwoPartUpdateIsTheOneCallUpdate) {
   EXPECT_NE(refused.error().find("first part"), std::string::npos) << refused.error();
   EXPECT_EQ(cut_model.num_nodes, one.num_nodes);
   EXPECT_TRUE(cut_model.mass == one.mass);
+}
+
+// The first part with a thread lent (CutUpdate3DOptions::beside: the element comparison and
+// the springs on it) gives the same model to the last bit, for the SIMD and the baseline
+// forms, after a complete and after a partial cut; every job it lends is waited for, also
+// when it fails.
+TEST(TissueUpdate3D, WorkBesideGivesTheSameModel) {
+  const cutting::TetMesh mesh = testing::boxTetMesh(6, 6, 6, 1.0);
+  Material mat;
+  mat.label = 1;
+  mat.stiffness_damping_s = 1e-4;
+  std::vector<int> fixed;
+  for (int i = 0; i < mesh.numNodes(); ++i)
+    if (mesh.X(i, 2) < 0.5) fixed.push_back(i);
+  const cutting::CutSurface complete = *cutting::CutSurface::plane(Vec3(0, 0, 3.04), Vec3(0.03, 0.02, 1));
+  // A strip ending inside the box: a partial cut.
+  cutting::Positions sx(4, 3);
+  sx << -1, -1, 2.6, 3.5, -1, 2.7, -1, 7, 2.65, 3.5, 7, 2.75;
+  cutting::Tris sf(2, 3);
+  sf << 0, 1, 3, 0, 3, 2;
+  const cutting::CutSurface partial = *cutting::CutSurface::triangles(sx, sf);
+  for (const cutting::CutSurface* surface : {&complete, &partial}) {
+    auto r = cutting::cut3d(mesh, *surface);
+    ASSERT_TRUE(r.ok()) << r.error();
+    ASSERT_GT(r->change.new_nodes.size(), 0u);
+    std::vector<std::uint8_t> flags(static_cast<size_t>(r->mesh.numNodes()), 0);
+    for (int i = 0; i < r->mesh.numNodes(); ++i) flags[i] = r->mesh.X(i, 2) < 0.5 ? 1 : 0;
+    for (const bool simd : {true, false}) {
+      ModelOptions model_options;
+      model_options.simd = simd;
+      auto built = buildModel(mesh, {mat}, fixed, model_options);
+      ASSERT_TRUE(built.ok());
+      Model alone = *built, beside = *built;
+      CutUpdate3DPrepared pa, pb;
+      ASSERT_TRUE(prepareModelAfterCut3D(alone, mesh, r->mesh, r->change, {}, &pa).ok());
+      testing::ThreadBeside threads;
+      CutUpdate3DOptions options;
+      options.beside = threads.lend();
+      ASSERT_TRUE(prepareModelAfterCut3D(beside, mesh, r->mesh, r->change, options, &pb).ok());
+      EXPECT_EQ(threads.jobs(), 2);
+      for (const std::thread& t : threads.threads) EXPECT_FALSE(t.joinable());  // waited for
+      EXPECT_TRUE(pa.mass == pb.mass);
+      EXPECT_TRUE(pa.touched == pb.touched);
+      EXPECT_TRUE(pa.region == pb.region);
+      ASSERT_EQ(pa.springs.size(), pb.springs.size());
+      EXPECT_EQ(0, std::memcmp(pa.springs.data(), pb.springs.data(), pa.springs.size() * sizeof(pa.springs[0])));
+      EXPECT_EQ(pa.report.touched_nodes, pb.report.touched_nodes);
+      EXPECT_EQ(pa.report.springs_recomputed, pb.report.springs_recomputed);
+      EXPECT_GT(pa.report.springs_recomputed, 0);
+      CutUpdate3DReport ra, rb;
+      ASSERT_TRUE(finishModelAfterCut3D(alone, r->mesh, r->change, flags, {}, {}, pa, &ra).ok());
+      ASSERT_TRUE(finishModelAfterCut3D(beside, r->mesh, r->change, flags, {}, {}, pb, &rb).ok());
+      EXPECT_TRUE(alone.mass == beside.mass);
+      EXPECT_TRUE(alone.springs == beside.springs);
+      EXPECT_TRUE(alone.stiffness == beside.stiffness);
+      EXPECT_TRUE(alone.damping == beside.damping);
+      EXPECT_TRUE(alone.rest_length == beside.rest_length);
+      EXPECT_EQ(alone.omega_max, beside.omega_max);
+      EXPECT_EQ(alone.substeps, beside.substeps);
+      EXPECT_TRUE(alone.stability_mode == beside.stability_mode);
+      EXPECT_EQ(ra.lanczos_steps, rb.lanczos_steps);
+    }
+    // A material the model does not know: the same error, after the job lent first (the
+    // element comparison) was waited for.
+    cutting::TetMesh unknown = r->mesh;
+    unknown.material[unknown.numTets() / 2] = 7;
+    auto built = buildModel(mesh, {mat}, fixed, {});
+    ASSERT_TRUE(built.ok());
+    testing::ThreadBeside threads;
+    CutUpdate3DOptions options;
+    options.beside = threads.lend();
+    CutUpdate3DPrepared failed;
+    const Status st = prepareModelAfterCut3D(*built, mesh, unknown, r->change, options, &failed);
+    ASSERT_FALSE(st.ok());
+    EXPECT_NE(st.error().find("material label 7"), std::string::npos) << st.error();
+    EXPECT_EQ(threads.jobs(), 1);
+    for (const std::thread& t : threads.threads) EXPECT_FALSE(t.joinable());
+  }
 }
 
 // An estimate that is followed by a round of mass scaling whatever its exact value stops as

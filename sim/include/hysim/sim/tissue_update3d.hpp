@@ -6,6 +6,7 @@
 // sim::buildModel); the state remapped (new nodes interpolate position and velocity from
 // their parents with the TopologyChange's weights).
 #include <Eigen/Core>
+#include <functional>
 #include <vector>
 
 #include "hysim/cutting/mesh.hpp"
@@ -119,6 +120,11 @@ struct CutUpdate3DOptions {
   // already needs more substeps than allowed) stops there: the round's estimate replaces it,
   // so the model is the same to the last bit (false: every estimate runs to convergence).
   bool stop_decided_estimates = true;
+  // Optional: starts a job on another thread and returns what waits for it (as
+  // cutting::Cut3DOptions::beside). The first part hands it the comparison of the elements
+  // with the old ones (beside the node -> tets lists) and the springs between touched nodes
+  // (beside the masses); the result is the same to the last bit. Empty: one thread.
+  std::function<std::function<void()>(std::function<void()>)> beside;
 };
 
 struct CutUpdate3DReport {
