@@ -874,11 +874,17 @@ Status prepareModelAfterCut3D(const Model& model, const cutting::TetMesh& before
     rep.masses.clamped = clamped;
     rep.masses.moment_residual = res.cwiseAbs().maxCoeff() / std::max(target.cwiseAbs().maxCoeff(), 1e-300);
   }
-  for (int j : region_nodes)
-    if (!(mass[j] >= 0.0) || !std::isfinite(mass[j])) return Error{"updateModelAfterCut3D: non-finite or negative mass"};
-
+  bool masses_ok = true;
+  for (int j : region_nodes) masses_ok = masses_ok && mass[j] >= 0.0 && std::isfinite(mass[j]);
   springs_lent.join();
-  if (!springs_status.ok()) return springs_status;
+  if (!masses_ok) {
+    prepared->springs.clear();  // (as before the springs were lent: nothing of a failed first part)
+    return Error{"updateModelAfterCut3D: non-finite or negative mass"};
+  }
+  if (!springs_status.ok()) {
+    prepared->springs.clear();
+    return springs_status;
+  }
   rep.springs_recomputed = recomputed;
   prepared->num_nodes_before = N0;
   prepared->mass = std::move(mass);

@@ -3,6 +3,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <cstring>
+#include <limits>
 #include <map>
 #include <random>
 
@@ -353,24 +354,34 @@ TEST(TissueUpdate3D, TwoPartUpdateIsTheOneCallUpdate) {
 
 // The first part with a thread lent (CutUpdate3DOptions::beside: the element comparison and
 // the springs on it) gives the same model to the last bit, for the SIMD and the baseline
-// forms, after a complete and after a partial cut; every job it lends is waited for, also
-// when it fails.
+// forms, after a complete and after partial cuts (a small one in a larger box, whose masses
+// sum over the touched nodes' tets rather than over all tets); every job it lends is waited
+// for, also when it fails (with only the comparison lent, and with the springs lent). Data
+// races between the two threads are for ThreadSanitizer to find; here they would show as a
+// different model.
 TEST(TissueUpdate3D, WorkBesideGivesTheSameModel) {
-  const cutting::TetMesh mesh = testing::boxTetMesh(6, 6, 6, 1.0);
+  const cutting::TetMesh box6 = testing::boxTetMesh(6, 6, 6, 1.0);
+  const cutting::TetMesh box12 = testing::boxTetMesh(12, 12, 12, 1.0);
   Material mat;
   mat.label = 1;
   mat.stiffness_damping_s = 1e-4;
-  std::vector<int> fixed;
-  for (int i = 0; i < mesh.numNodes(); ++i)
-    if (mesh.X(i, 2) < 0.5) fixed.push_back(i);
   const cutting::CutSurface complete = *cutting::CutSurface::plane(Vec3(0, 0, 3.04), Vec3(0.03, 0.02, 1));
-  // A strip ending inside the box: a partial cut.
-  cutting::Positions sx(4, 3);
-  sx << -1, -1, 2.6, 3.5, -1, 2.7, -1, 7, 2.65, 3.5, 7, 2.75;
-  cutting::Tris sf(2, 3);
-  sf << 0, 1, 3, 0, 3, 2;
-  const cutting::CutSurface partial = *cutting::CutSurface::triangles(sx, sf);
-  for (const cutting::CutSurface* surface : {&complete, &partial}) {
+  // Strips ending inside the box: partial cuts.
+  auto strip = [](double x0, double x1, double y0, double y1, double z) {
+    cutting::Positions sx(4, 3);
+    sx << x0, y0, z, x1, y0, z + 0.1, x0, y1, z + 0.05, x1, y1, z + 0.15;
+    cutting::Tris sf(2, 3);
+    sf << 0, 1, 3, 0, 3, 2;
+    return *cutting::CutSurface::triangles(sx, sf);
+  };
+  const cutting::CutSurface partial = strip(-1, 3.5, -1, 7, 2.6), small = strip(-1, 2.5, 4.3, 7.7, 6.55);
+  const std::pair<const cutting::TetMesh*, const cutting::CutSurface*> cases[] = {
+      {&box6, &complete}, {&box6, &partial}, {&box12, &small}};
+  for (const auto& [mesh_ptr, surface] : cases) {
+    const cutting::TetMesh& mesh = *mesh_ptr;
+    std::vector<int> fixed;
+    for (int i = 0; i < mesh.numNodes(); ++i)
+      if (mesh.X(i, 2) < 0.5) fixed.push_back(i);
     auto r = cutting::cut3d(mesh, *surface);
     ASSERT_TRUE(r.ok()) << r.error();
     ASSERT_GT(r->change.new_nodes.size(), 0u);
@@ -398,6 +409,7 @@ TEST(TissueUpdate3D, WorkBesideGivesTheSameModel) {
       EXPECT_EQ(pa.report.touched_nodes, pb.report.touched_nodes);
       EXPECT_EQ(pa.report.springs_recomputed, pb.report.springs_recomputed);
       EXPECT_GT(pa.report.springs_recomputed, 0);
+      EXPECT_LT(pa.report.touched_nodes, r->mesh.numNodes());
       CutUpdate3DReport ra, rb;
       ASSERT_TRUE(finishModelAfterCut3D(alone, r->mesh, r->change, flags, {}, {}, pa, &ra).ok());
       ASSERT_TRUE(finishModelAfterCut3D(beside, r->mesh, r->change, flags, {}, {}, pb, &rb).ok());
@@ -411,21 +423,39 @@ TEST(TissueUpdate3D, WorkBesideGivesTheSameModel) {
       EXPECT_TRUE(alone.stability_mode == beside.stability_mode);
       EXPECT_EQ(ra.lanczos_steps, rb.lanczos_steps);
     }
-    // A material the model does not know: the same error, after the job lent first (the
-    // element comparison) was waited for.
-    cutting::TetMesh unknown = r->mesh;
-    unknown.material[unknown.numTets() / 2] = 7;
     auto built = buildModel(mesh, {mat}, fixed, {});
     ASSERT_TRUE(built.ok());
-    testing::ThreadBeside threads;
-    CutUpdate3DOptions options;
-    options.beside = threads.lend();
-    CutUpdate3DPrepared failed;
-    const Status st = prepareModelAfterCut3D(*built, mesh, unknown, r->change, options, &failed);
-    ASSERT_FALSE(st.ok());
-    EXPECT_NE(st.error().find("material label 7"), std::string::npos) << st.error();
-    EXPECT_EQ(threads.jobs(), 1);
-    for (const std::thread& t : threads.threads) EXPECT_FALSE(t.joinable());
+    {
+      // A material the model does not know: the same error, after the job lent first (the
+      // element comparison) was waited for.
+      cutting::TetMesh unknown = r->mesh;
+      unknown.material[unknown.numTets() / 2] = 7;
+      testing::ThreadBeside threads;
+      CutUpdate3DOptions options;
+      options.beside = threads.lend();
+      CutUpdate3DPrepared failed;
+      const Status st = prepareModelAfterCut3D(*built, mesh, unknown, r->change, options, &failed);
+      ASSERT_FALSE(st.ok());
+      EXPECT_NE(st.error().find("material label 7"), std::string::npos) << st.error();
+      EXPECT_EQ(threads.jobs(), 1);
+      for (const std::thread& t : threads.threads) EXPECT_FALSE(t.joinable());
+    }
+    {
+      // Masses that cannot be kept (the old ones not finite): the error once the springs lent
+      // beside the masses were waited for, and no springs left in the first part.
+      Model broken = *built;
+      broken.mass.setConstant(std::numeric_limits<double>::quiet_NaN());
+      testing::ThreadBeside threads;
+      CutUpdate3DOptions options;
+      options.beside = threads.lend();
+      CutUpdate3DPrepared failed;
+      const Status st = prepareModelAfterCut3D(broken, mesh, r->mesh, r->change, options, &failed);
+      ASSERT_FALSE(st.ok());
+      EXPECT_NE(st.error().find("non-finite or negative mass"), std::string::npos) << st.error();
+      EXPECT_EQ(threads.jobs(), 2);
+      for (const std::thread& t : threads.threads) EXPECT_FALSE(t.joinable());
+      EXPECT_TRUE(failed.springs.empty());
+    }
   }
 }
 
