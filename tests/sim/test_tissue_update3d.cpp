@@ -33,6 +33,19 @@ void checkMasses(const cutting::TetMesh& before, const cutting::TetMesh& after, 
   EXPECT_GT(report.unknowns, 0);
 }
 
+// Two updated models with the same bits: masses, springs, stability.
+void expectSameModel(const Model& a, const Model& b) {
+  EXPECT_EQ(a.num_nodes, b.num_nodes);
+  EXPECT_TRUE(a.mass == b.mass);
+  EXPECT_TRUE(a.springs == b.springs);
+  EXPECT_TRUE(a.stiffness == b.stiffness);
+  EXPECT_TRUE(a.damping == b.damping);
+  EXPECT_TRUE(a.rest_length == b.rest_length);
+  EXPECT_EQ(a.omega_max, b.omega_max);
+  EXPECT_EQ(a.substeps, b.substeps);
+  EXPECT_TRUE(a.stability_mode == b.stability_mode);
+}
+
 // A one-material model of `mesh` with the nodes below z = 0.5 held.
 auto modelHeldBelowHalf(const cutting::TetMesh& mesh) {
   Material mat;
@@ -331,13 +344,7 @@ TEST(TissueUpdate3D, TwoPartUpdateIsTheOneCallUpdate) {
   ASSERT_TRUE(prepareModelAfterCut3D(two, mesh, r->mesh, r->change, {}, &prepared).ok());
   ASSERT_TRUE(finishModelAfterCut3D(two, r->mesh, r->change, fixed, keep, {}, prepared, &rep_two).ok());
   EXPECT_LT(one.num_nodes, n);
-  EXPECT_EQ(one.num_nodes, two.num_nodes);
-  EXPECT_TRUE(one.mass == two.mass);
-  EXPECT_TRUE(one.springs == two.springs);
-  EXPECT_TRUE(one.stiffness == two.stiffness);
-  EXPECT_TRUE(one.damping == two.damping);
-  EXPECT_EQ(one.omega_max, two.omega_max);
-  EXPECT_EQ(one.substeps, two.substeps);
+  expectSameModel(one, two);
   EXPECT_EQ(rep_one.lanczos_steps, rep_two.lanczos_steps);
   EXPECT_EQ(rep_one.touched_nodes, rep_two.touched_nodes);
   // A first part for another model (the cut one) is refused, and the model is left as it was.
@@ -413,14 +420,7 @@ TEST(TissueUpdate3D, WorkBesideGivesTheSameModel) {
       CutUpdate3DReport ra, rb;
       ASSERT_TRUE(finishModelAfterCut3D(alone, r->mesh, r->change, flags, {}, {}, pa, &ra).ok());
       ASSERT_TRUE(finishModelAfterCut3D(beside, r->mesh, r->change, flags, {}, {}, pb, &rb).ok());
-      EXPECT_TRUE(alone.mass == beside.mass);
-      EXPECT_TRUE(alone.springs == beside.springs);
-      EXPECT_TRUE(alone.stiffness == beside.stiffness);
-      EXPECT_TRUE(alone.damping == beside.damping);
-      EXPECT_TRUE(alone.rest_length == beside.rest_length);
-      EXPECT_EQ(alone.omega_max, beside.omega_max);
-      EXPECT_EQ(alone.substeps, beside.substeps);
-      EXPECT_TRUE(alone.stability_mode == beside.stability_mode);
+      expectSameModel(alone, beside);
       EXPECT_EQ(ra.lanczos_steps, rb.lanczos_steps);
     }
     auto built = buildModel(mesh, {mat}, fixed, {});
