@@ -704,24 +704,20 @@ Status prepareModelAfterCut3D(const Model& model, const cutting::TetMesh& before
   for (int t = T1 - 1; t >= 0; --t)
     for (int k = 3; k >= 0; --k) around[--off[node(t, k)]] = t;
   std::vector<double> volume(static_cast<size_t>(T1), std::nan(""));
-  auto tetVolume = [&](int t) {
-    if (std::isnan(volume[t])) {  // cutting::tetVolume's arithmetic, inlined
-      const Eigen::Vector3d x0 = after.X.row(node(t, 0));
-      const Eigen::Vector3d x1 = after.X.row(node(t, 1));
-      const Eigen::Vector3d x2 = after.X.row(node(t, 2));
-      const Eigen::Vector3d x3 = after.X.row(node(t, 3));
-      volume[t] = (x1 - x0).dot((x2 - x0).cross(x3 - x0)) / 6.0;
-    }
-    return volume[t];
-  };
-  auto volumeOf = [&](int t) {  // tetVolume without writing the cache (for the springs job)
-    const double v = volume[t];
-    if (!std::isnan(v)) return v;
+  auto computeVolume = [&](int t) {  // cutting::tetVolume's arithmetic, inlined
     const Eigen::Vector3d x0 = after.X.row(node(t, 0));
     const Eigen::Vector3d x1 = after.X.row(node(t, 1));
     const Eigen::Vector3d x2 = after.X.row(node(t, 2));
     const Eigen::Vector3d x3 = after.X.row(node(t, 3));
     return (x1 - x0).dot((x2 - x0).cross(x3 - x0)) / 6.0;
+  };
+  auto tetVolume = [&](int t) {
+    if (std::isnan(volume[t])) volume[t] = computeVolume(t);
+    return volume[t];
+  };
+  auto volumeOf = [&](int t) {  // tetVolume without writing the cache (for the springs job)
+    const double v = volume[t];
+    return std::isnan(v) ? computeVolume(t) : v;
   };
 
   compare.join();
@@ -802,13 +798,13 @@ Status prepareModelAfterCut3D(const Model& model, const cutting::TetMesh& before
   };
   std::vector<EdgeSum> edge_sums;
   std::vector<int> slot(static_cast<size_t>(N1), -1);
-  // About 7 edges a node towards higher-numbered neighbours in a tet mesh: room for most
-  // cuts without regrowing (each regrowth copies the springs collected so far).
   int recomputed = 0;
   Status springs_status;
   // (Beside the masses' correction: it reads the volumes the lumped priors computed, every tet
   // around a touched node, and writes only `springs`, recomputed and springs_status.)
   const std::function<void()> springsJob = [&] {
+    // About 7 edges a node towards higher-numbered neighbours in a tet mesh: room for most
+    // cuts without regrowing (each regrowth copies the springs collected so far).
     springs.reserve(8 * static_cast<size_t>(rep.touched_nodes));
     for (int r = 0; r < rep.touched_nodes; ++r) {
       const int a = region_nodes[r];
