@@ -111,14 +111,42 @@ hysim::cutting::CutSurface planeThrough(const TetMesh& m, int which) {
 // The simulator's update after a pass: anchored after the cut are the surviving nodes that
 // were anchored (new nodes are free); `model` is a copy of p.model, updated in place.
 hysim::Status incrementalUpdate(const Prepared& p, const hysim::cutting::Cut3DResult& r, hysim::sim::Model& model,
-                                     std::vector<std::uint8_t>& fixed) {
+                                     std::vector<std::uint8_t>& fixed, hysim::sim::CutUpdate3DReport* report = nullptr) {
   fixed.assign(static_cast<size_t>(r.mesh.numNodes()), 0);
   for (int i = 0; i < p.mesh.numNodes(); ++i) {
     const int j = r.change.node_old_to_new[i];
     if (j >= 0) fixed[j] = p.model.fixed[i] ? 1 : 0;
   }
-  return hysim::sim::updateModelAfterCut3D(model, p.mesh, r.mesh, r.change, fixed, {});
+  return hysim::sim::updateModelAfterCut3D(model, p.mesh, r.mesh, r.change, fixed, {}, {}, report);
 }
+
+// The steps' wall times (Cut3DReport's and CutUpdate3DReport's *_ms), summed over the
+// iterations and given as means per iteration: counters classify_ms (with the node -> tets
+// lists), snap_ms, separate_ms (subdivision and separation), collapse_ms, late_snap_ms and
+// move_ms (in optimize_ms), prepare_ms (the update's first part) and stability_ms.
+struct PhaseTimes {
+  double classify = 0, snap = 0, separate = 0, collapse = 0, late_snap = 0, move = 0, prepare = 0, stability = 0;
+  void add(const hysim::cutting::Cut3DReport& c, const hysim::sim::CutUpdate3DReport& u) {
+    classify += c.classify_ms;
+    snap += c.snap_ms;
+    separate += c.subdivide_ms + c.separate_ms;
+    collapse += c.collapse_ms;
+    late_snap += c.late_snap_ms;
+    move += c.move_ms;
+    prepare += u.prepare_ms;
+    stability += u.stability_ms;
+  }
+  void report(benchmark::State& state, double n) const {
+    state.counters["classify_ms"] = classify / n;
+    state.counters["snap_ms"] = snap / n;
+    state.counters["separate_ms"] = separate / n;
+    state.counters["collapse_ms"] = collapse / n;
+    state.counters["late_snap_ms"] = late_snap / n;
+    state.counters["move_ms"] = move / n;
+    state.counters["prepare_ms"] = prepare / n;
+    state.counters["stability_ms"] = stability / n;
+  }
+};
 
 void BM_Cut3DUpdate(benchmark::State& state) {
   const Prepared& p = mesh(static_cast<int>(state.range(0)));
@@ -133,6 +161,7 @@ void BM_Cut3DUpdate(benchmark::State& state) {
   const bool incremental = state.range(3) != 0;
   double cutMs = 0, optMs = 0, updMs = 0;
   std::vector<double> updCpu;
+  PhaseTimes phases;
   int elements = 0, nodes = 0;
   hysim::sim::Model model;
   std::vector<std::uint8_t> fixed;
@@ -152,11 +181,13 @@ void BM_Cut3DUpdate(benchmark::State& state) {
     timespec c0, c1;
     clock_gettime(CLOCK_THREAD_CPUTIME_ID, &c0);
     if (incremental) {
-      const auto st = incrementalUpdate(p, *r, model, fixed);
+      hysim::sim::CutUpdate3DReport update;
+      const auto st = incrementalUpdate(p, *r, model, fixed, &update);
       if (!st.ok()) {
         state.SkipWithError(st.error().c_str());
         return;
       }
+      phases.add(r->report, update);
     } else {
       auto rebuilt = hysim::sim::updateModel3D(p.model, p.mesh, r->mesh, r->change);
       if (!rebuilt.ok()) {
@@ -185,6 +216,7 @@ void BM_Cut3DUpdate(benchmark::State& state) {
   if (!updCpu.empty()) state.counters["update_cpu_med_ms"] = updCpu[updCpu.size() / 2];
   state.counters["tets"] = elements;
   state.counters["nodes"] = nodes;
+  if (incremental) phases.report(state, n);
   state.SetLabel(p.name + " plane " + std::to_string(plane) + " " + hysim::cutting::cutMethodName(o.method) +
                  (incremental ? ", incremental update" : ", rebuilt model"));
 }
@@ -224,6 +256,7 @@ void BM_Cut3DUpdateTwoThreads(benchmark::State& state) {
   hysim::sim::CutUpdate3DOptions update;
   update.beside = o.beside;
   double cutMs = 0, optMs = 0, updMs = 0;
+  PhaseTimes phases;
   hysim::sim::Model model;
   std::vector<std::uint8_t> fixed;
   auto noop = [] {};
@@ -250,9 +283,11 @@ void BM_Cut3DUpdateTwoThreads(benchmark::State& state) {
       if (j >= 0) fixed[j] = p.model.fixed[i] ? 1 : 0;
     }
     auto s = hysim::sim::remapState3D(p.state, r->change);
+    hysim::sim::CutUpdate3DReport updateReport;
     const hysim::Status st =
-        prepareStatus.ok() ? hysim::sim::finishModelAfterCut3D(model, r->mesh, r->change, fixed, {}, update, prepared)
-                           : prepareStatus;
+        prepareStatus.ok()
+            ? hysim::sim::finishModelAfterCut3D(model, r->mesh, r->change, fixed, {}, update, prepared, &updateReport)
+            : prepareStatus;
     const auto t2 = std::chrono::steady_clock::now();
     worker.end();
     if (!st.ok()) {
@@ -264,11 +299,13 @@ void BM_Cut3DUpdateTwoThreads(benchmark::State& state) {
     cutMs += std::chrono::duration<double, std::milli>(t1 - t0).count();
     updMs += std::chrono::duration<double, std::milli>(t2 - t1).count();
     optMs += r->report.optimize_ms;
+    phases.add(r->report, updateReport);
   }
   const double n = static_cast<double>(state.iterations());
   state.counters["cut_ms"] = cutMs / n;
   state.counters["optimize_ms"] = optMs / n;
   state.counters["update_ms"] = updMs / n;
+  phases.report(state, n);
   state.SetLabel(p.name + " plane " + std::to_string(plane) + " hybrid, incremental update, two threads");
 }
 BENCHMARK(BM_Cut3DUpdateTwoThreads)

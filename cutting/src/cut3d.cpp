@@ -489,6 +489,13 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
   Cut3DResult result;
   TetMesh& out = result.mesh;  // written at Assemble
   Cut3DReport& report = result.report;
+  // The steps' wall times (report.*_ms): each lap adds the time since the last.
+  auto mark = start;
+  auto lap = [&mark](double& into) {
+    const auto now = std::chrono::steady_clock::now();
+    into += std::chrono::duration<double, std::milli>(now - mark).count();
+    mark = now;
+  };
   TopologyChange& change = result.change;
   auto materialOf = [&](int t) { return input.material.size() != 0 ? input.material(t) : 0; };
 
@@ -625,6 +632,7 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
   }
   const std::vector<std::int32_t>& starOff = stars.off;
   const StarVector& starTet = stars.star;
+  lap(report.classify_ms);
 
   auto crossingPoint = [&](const CrossedEdge& e) -> Vec3 {
     if (!plane) return e.point;
@@ -1048,6 +1056,7 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
               std::max(report.max_route_deviation_mm, std::abs(plane ? phi[n] : surface.signedDistance(w.x(n))));
   }
 
+  lap(report.snap_ms);
   // 3. Subdivision: split every edge still crossed (conforming bisection of the tets around
   //    it), or, for deletion, remove the crossed tets.
   std::vector<std::int32_t> localOf(M0, -1);   // original tet -> index into fragments
@@ -1097,6 +1106,7 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
     report.split_elements = static_cast<int>(splitOriginals.size());
   }
 
+  lap(report.subdivide_ms);
   // 4. Separation. Local tets: the current stars of all nodes on the cut.
   auto isDeleted = [&](int t) { return deleting && t < M0 && deleted[t]; };
   std::vector<std::int32_t> local;
@@ -1339,6 +1349,7 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
     change.cut_faces.push_back({tv[kFace[opp][0]], tv[kFace[opp][1]], tv[kFace[opp][2]]});
   }
   report.cut_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  lap(report.separate_ms);
 
   // Assemble.
   const int N1 = w.numNodes(), M1 = w.numTets();
@@ -1388,6 +1399,7 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
   }
   for (int t = M0; t < M1; ++t) change.added_elements.push_back(t);
 
+  lap(report.assemble_ms);
   std::vector<std::uint8_t> peeled;  // #M1: slivers the optimisation removed
   // 5. Local optimisation (hybrid), from the nodes the cut created, moved or separated.
   // (Also when the surface split edges but made no cut face, e.g. a sweep's edge grazing the
@@ -1463,7 +1475,11 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
     report.peeled_volume = counts.peeled_volume;
     report.optimized_nodes = static_cast<int>(moved.size() - before);
     report.optimize_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - optStart).count();
+    report.collapse_ms = counts.collapse_ms;
+    report.late_snap_ms = counts.late_snap_ms;
+    report.move_ms = counts.move_ms;
   }
+  mark = std::chrono::steady_clock::now();  // (the optimisation is optimize_ms)
   {  // (Sorted without repeats, as sort + unique, through a bit per node.)
     IndexBits nodeBits(out.numNodes());
     for (const int n : moved) nodeBits.mark(n);
@@ -1612,6 +1628,7 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
   }
   change.new_num_nodes = out.numNodes();
   change.new_num_elements = out.numTets();
+  lap(report.compact_ms);
   return result;
 }
 

@@ -30,6 +30,7 @@
 #include <algorithm>
 #include <array>
 #include <bit>
+#include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
@@ -128,6 +129,12 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   // are flipped, snaps and collapses measure volume against the local edge; plane cuts keep
   // the plane-cut behaviour.
   const bool curved = region.surface != nullptr && !plane;
+  // Runs step() and adds its wall time to *ms (counts' timings, when counts are asked for).
+  auto timed = [counts](double OptimizeCounts::*ms, auto&& step) {
+    const auto start = std::chrono::steady_clock::now();
+    step();
+    if (counts) counts->*ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  };
   std::vector<std::uint8_t> onCut = region.on_cut;  // grows: nodes snapped onto the cut here
   const double cosFlat = std::cos(options.boundary_flat_deg * M_PI / 180.0);
   const double cosCurved =
@@ -2131,8 +2138,8 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       }
     }
   };
-  snapNear();
-  collapseEdges();
+  timed(&OptimizeCounts::late_snap_ms, snapNear);
+  timed(&OptimizeCounts::collapse_ms, collapseEdges);
   flips();
 
   // Nodes up to `rings` edge steps from the seeds may move.
@@ -2592,7 +2599,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   for (; it < options.max_iterations && !work.empty(); ++it) {
     for (MoveLane& L : moveLane) L.largest = L.scale = 0;
     movedNow.clear();
-    moveRun(work);
+    timed(&OptimizeCounts::move_ms, [&] { moveRun(work); });
     const double largest = std::max(moveLane[0].largest, moveLane[1].largest);
     const double scale = std::max(moveLane[0].scale, moveLane[1].scale);
     work.clear();
@@ -2604,8 +2611,8 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   }
   bfStart.clear();
   if (counts) counts->iterations = it;
-  snapNear();  // moves may have made new short edges on the cut
-  collapseEdges();
+  timed(&OptimizeCounts::late_snap_ms, snapNear);  // moves may have made new short edges on the cut
+  timed(&OptimizeCounts::collapse_ms, collapseEdges);
   flips();
   peel();
   if (moved)
@@ -2621,7 +2628,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     // non-manifold (every collapse there was refused): collapse their edges, the node
     // staying as it was.
     lastResort = true;
-    collapseEdges();
+    timed(&OptimizeCounts::collapse_ms, collapseEdges);
   }
 }
 

@@ -88,6 +88,7 @@ struct OptimizeCounts {
   int flap_peeled = 0;  // of peeled: in flaps (flap_peel.cpp)
   std::vector<std::int32_t> onto_cut;  // the nodes late snapping moved onto the cut
   double peeled_volume = 0;
+  double collapse_ms = 0, late_snap_ms = 0, move_ms = 0;  // wall time of those steps
 };
 
 // See Optimize3DOptions. Appends the nodes it moved to *moved; *dead (#T) marks the slivers

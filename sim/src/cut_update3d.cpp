@@ -2,6 +2,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <functional>
 #include <immintrin.h>
@@ -556,6 +557,7 @@ double topEigenvalueBound(const Model& m, const cutting::Positions& X, const std
 Status prepareModelAfterCut3D(const Model& model, const cutting::TetMesh& before, const cutting::TetMesh& after,
                               const cutting::TopologyChange& change, const CutUpdate3DOptions& options,
                               CutUpdate3DPrepared* prepared) {
+  const auto start = std::chrono::steady_clock::now();
   const int N0 = before.numNodes(), N1 = after.numNodes(), T1 = after.numTets();
   *prepared = CutUpdate3DPrepared{};
   if (model.num_nodes != N0 || model.mass.size() != N0) return Error{"updateModelAfterCut3D: the model is not the mesh's"};
@@ -886,6 +888,7 @@ Status prepareModelAfterCut3D(const Model& model, const cutting::TetMesh& before
   prepared->mass = std::move(mass);
   prepared->touched = std::move(touched);
   prepared->region = std::move(region);
+  rep.prepare_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return Status::Ok();
 }
 
@@ -937,6 +940,10 @@ Status finishModelAfterCut3D(Model& model, const cutting::TetMesh& after, const 
   m.inv_mass = Eigen::VectorXd::Zero(N2);
   for (int i = 0; i < N2; ++i)
     if (!m.fixed[i]) m.inv_mass[i] = 1.0 / m.mass[i];
+  auto msSince = [](std::chrono::steady_clock::time_point t) {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
+  };
+  const auto springs_start = std::chrono::steady_clock::now();
   // Unchanged springs, compacted in place (a row is read before any row at or above it is
   // written), then the recomputed ones: the order of a full copy.
   // Each old node's fate in one lookup per spring end: 2 * its kept index + (touched ? 1 : 0),
@@ -996,6 +1003,7 @@ Status finishModelAfterCut3D(Model& model, const cutting::TetMesh& after, const 
     countStep(keep[sp.a], keep[sp.b]);
   }
   fillStepSprings(m, step_count);
+  rep.springs_ms = msSince(springs_start);
   cutting::Positions X(N2, 3);
   for (int i = 0; i < N1; ++i)
     if (keep[i] >= 0) X.row(keep[i]) = after.X.row(i);
@@ -1079,6 +1087,7 @@ Status finishModelAfterCut3D(Model& model, const cutting::TetMesh& after, const 
       carryPrevious();
     }
   };
+  const auto stability_start = std::chrono::steady_clock::now();
   estimate(true);
   // Selective mass scaling, as buildModel, on the nodes of the estimate.
   // A carried-over previous estimate is not lowered by mass near the cut: no rounds then.
@@ -1100,6 +1109,7 @@ Status finishModelAfterCut3D(Model& model, const cutting::TetMesh& after, const 
       target *= 0.7;
     }
   }
+  rep.stability_ms = msSince(stability_start);
   m.substeps = opt.substeps > 0 ? opt.substeps : substepsFor(m.critical_dt);
   if (opt.substeps <= 0 && opt.max_substeps > 0) m.substeps = std::min(m.substeps, opt.max_substeps);
   m.substep = opt.dt / m.substeps;

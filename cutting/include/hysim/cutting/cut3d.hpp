@@ -241,6 +241,13 @@ struct Cut3DReport {
   int cut_off_pieces = 0;     // pieces left out of the optimisation (anchored_nodes)
   int cut_off_elements = 0;   // their tets
   double cut_ms = 0, optimize_ms = 0;
+  // Wall time of the steps (ms), for profiling: classification (with the node -> tets lists
+  // and the work arrays), snapping (with moving away and routing), subdivision, separation,
+  // assembly (the output arrays, the node -> tets lists patched, the pieces cut off), the
+  // compaction after the optimisation; and of the optimisation's edge collapses, late snaps
+  // and move loop (parts of optimize_ms).
+  double classify_ms = 0, snap_ms = 0, subdivide_ms = 0, separate_ms = 0, assemble_ms = 0, compact_ms = 0;
+  double collapse_ms = 0, late_snap_ms = 0, move_ms = 0;
 };
 
 struct Cut3DResult {
