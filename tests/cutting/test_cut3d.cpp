@@ -583,6 +583,33 @@ TEST(Cut3D, WorkBesideGivesTheSameCut) {
   for (std::thread& t : threads.threads) EXPECT_FALSE(t.joinable());
 }
 
+// The report's step times: non-negative; the cut's steps are the time up to cut_ms, the
+// optimisation's steps within optimize_ms (a hybrid plane cut through a box that collapses
+// and moves nodes); a standard cut has no optimisation steps.
+TEST(Cut3D, ReportStepTimesAddUp) {
+  const TetMesh box = testing::boxTetMesh(8, 8, 8, 1.0);
+  const auto plane = CutSurface::plane(Vec3(0, 0, 4.07), Vec3(0.11, 0.07, 1.0).normalized());
+  ASSERT_TRUE(plane.ok());
+  const auto r = cut3d(box, *plane);
+  ASSERT_TRUE(r.ok()) << r.error();
+  const Cut3DReport& rep = r->report;
+  EXPECT_GT(rep.optimize_iterations, 0);
+  for (const double ms : {rep.classify_ms, rep.snap_ms, rep.subdivide_ms, rep.separate_ms, rep.assemble_ms,
+                          rep.compact_ms, rep.collapse_ms, rep.late_snap_ms, rep.move_ms})
+    EXPECT_GE(ms, 0.0);
+  const double cutSteps = rep.classify_ms + rep.snap_ms + rep.subdivide_ms + rep.separate_ms;
+  EXPECT_NEAR(cutSteps, rep.cut_ms, 0.01 + 0.05 * rep.cut_ms);
+  EXPECT_GT(rep.move_ms, 0.0);
+  EXPECT_LE(rep.collapse_ms + rep.late_snap_ms + rep.move_ms, rep.optimize_ms);
+  Cut3DOptions standard;
+  standard.method = CutMethod::Standard;
+  const auto s = cut3d(box, *plane, standard);
+  ASSERT_TRUE(s.ok()) << s.error();
+  EXPECT_EQ(s->report.optimize_ms, 0.0);
+  EXPECT_EQ(s->report.collapse_ms + s->report.late_snap_ms + s->report.move_ms, 0.0);
+  EXPECT_GT(s->report.classify_ms + s->report.subdivide_ms, 0.0);
+}
+
 TEST(Cut3D, StripIsTheSameSurfaceAsItsTriangles) {
   const int rows = 23, row_size = 13;
   Positions X(rows * row_size, 3);

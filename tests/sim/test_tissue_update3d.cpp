@@ -347,6 +347,10 @@ TEST(TissueUpdate3D, TwoPartUpdateIsTheOneCallUpdate) {
   expectSameModel(one, two);
   EXPECT_EQ(rep_one.lanczos_steps, rep_two.lanczos_steps);
   EXPECT_EQ(rep_one.touched_nodes, rep_two.touched_nodes);
+  // The steps' wall times are reported (the first part's kept through the second).
+  EXPECT_GT(rep_two.prepare_ms, 0.0);
+  EXPECT_GT(rep_two.springs_ms, 0.0);
+  EXPECT_GT(rep_two.stability_ms, 0.0);
   // A first part for another model (the cut one) is refused, and the model is left as it was.
   Model other = *built;
   CutUpdate3DPrepared stale;
