@@ -491,8 +491,7 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
   Cut3DReport& report = result.report;
   // The steps' wall times (report.*_ms): each lap adds the time since the last.
   auto mark = start;
-  auto lap = [&mark](double& into) {
-    const auto now = std::chrono::steady_clock::now();
+  auto lap = [&mark](double& into, std::chrono::steady_clock::time_point now = std::chrono::steady_clock::now()) {
     into += std::chrono::duration<double, std::milli>(now - mark).count();
     mark = now;
   };
@@ -1348,8 +1347,9 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
     const Tet tv = w.tet(t);
     change.cut_faces.push_back({tv[kFace[opp][0]], tv[kFace[opp][1]], tv[kFace[opp][2]]});
   }
-  report.cut_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-  lap(report.separate_ms);
+  const auto cutEnd = std::chrono::steady_clock::now();
+  report.cut_ms = std::chrono::duration<double, std::milli>(cutEnd - start).count();
+  lap(report.separate_ms, cutEnd);  // (the steps so far add up to cut_ms)
 
   // Assemble.
   const int N1 = w.numNodes(), M1 = w.numTets();
