@@ -475,16 +475,10 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
 
   // Node -> tets (CSR) of the input mesh, all tets, each list ascending (see below where it is
   // used): it reads the input only, so it is built beside the classification when options
-  // .beside lends a thread, and waited for before its first use (or any return).
+  // .beside lends a thread (here, first, when none is), and waited for before its first use
+  // (or any return).
   StarLists stars;
-  std::function<void()> waitStars;
-  struct WaitOnExit {
-    std::function<void()>& wait;
-    ~WaitOnExit() {
-      if (wait) wait();
-    }
-  } waitStarsOnExit{waitStars};
-  if (options.beside) waitStars = options.beside([&input, N0, &stars] { buildStarLists(input.T, N0, &stars); });
+  LentJob starsJob(options.beside, [&input, N0, &stars] { buildStarLists(input.T, N0, &stars); });
 
   Cut3DResult result;
   TetMesh& out = result.mesh;  // written at Assemble
@@ -623,12 +617,7 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
   // neighbours, subdivision and separation at the crossed tets and the nodes on the cut); the
   // optimisation takes the lists over, patched where the cut changed tets (one O(#T) build
   // for both).
-  if (waitStars) {
-    waitStars();
-    waitStars = nullptr;
-  } else {
-    buildStarLists(input.T, N0, &stars);
-  }
+  starsJob.join();
   const std::vector<std::int32_t>& starOff = stars.off;
   const StarVector& starTet = stars.star;
   lap(report.classify_ms);

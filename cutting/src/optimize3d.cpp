@@ -2566,10 +2566,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
         for (int n : partB) moveNode(n, 1);
       };
       if (region.beside) {
-        struct WaitOnExit {  // (part B uses this frame: waited for on every way out)
-          std::function<void()> wait;
-          ~WaitOnExit() { wait(); }
-        } waitB{region.beside(runB)};
+        LentJob partBJob(region.beside, runB);  // (part B uses this frame: waited for on every way out)
         for (int n : partA) moveNode(n, 0);
       } else {
         for (int n : partA) moveNode(n, 0);

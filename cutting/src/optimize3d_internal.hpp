@@ -76,7 +76,7 @@ struct CutRegion {
   // no operation reads or changes them. They start marked in *dead (the caller unmarks them).
   const std::vector<std::uint8_t>* left_alone = nullptr;
   // Optional: Cut3DOptions::beside, for the move loop's second lane.
-  std::function<std::function<void()>(std::function<void()>)> beside;
+  Beside beside;
 };
 
 struct OptimizeCounts {

@@ -569,29 +569,8 @@ Status prepareModelAfterCut3D(const Model& model, const cutting::TetMesh& before
   const int T0 = before.numTets();
   if (static_cast<int>(change.element_old_to_new.size()) != T0)
     return Error{"updateModelAfterCut3D: the change's element map does not match the mesh"};
-  // A job handed to options.beside (or run here without one), waited for by join() before its
-  // results are read, and on every way out: each is declared after what its job uses, so it
-  // is waited for before any of that goes.
-  struct Lent {
-    std::function<void()> wait;
-    Lent(const CutUpdate3DOptions& o, const std::function<void()>& job) {
-      if (o.beside) {
-        wait = o.beside(job);
-      } else {
-        job();
-      }
-    }
-    Lent(const Lent&) = delete;
-    Lent& operator=(const Lent&) = delete;
-    void join() {
-      if (wait) {
-        const std::function<void()> w = std::move(wait);
-        wait = nullptr;
-        w();
-      }
-    }
-    ~Lent() { join(); }
-  };
+  // The jobs handed to options.beside (cutting::LentJob: each declared after what its job
+  // uses, so it is waited for before any of that goes).
 
   // Touched nodes: their masses and the springs between them change.
   std::vector<std::uint8_t> touched(static_cast<size_t>(N1), 0);
@@ -657,7 +636,7 @@ Status prepareModelAfterCut3D(const Model& model, const cutting::TetMesh& before
       for (int t = 0; t < T1; ++t) compareElement(t);
     }
   };
-  Lent compare(options, compareJob);
+  cutting::LentJob compare(options.beside, compareJob);
 
   // Material of each tet (written in full below: allocated without a fill).
   const std::unique_ptr<int[]> material_storage(new int[static_cast<size_t>(T1)]);
@@ -845,7 +824,7 @@ Status prepareModelAfterCut3D(const Model& model, const cutting::TetMesh& before
       }
     }
   };
-  Lent springs_lent(options, springsJob);
+  cutting::LentJob springs_lent(options.beside, springsJob);
   if (!unknown.empty()) {
     Eigen::Vector3d lo = after.X.row(unknown[0]).transpose(), hi = lo;
     for (int j : unknown) {

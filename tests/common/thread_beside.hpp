@@ -6,11 +6,13 @@
 #include <functional>
 #include <thread>
 
+#include "hysim/cutting/beside.hpp"
+
 namespace hysim::testing {
 
 struct ThreadBeside {
   std::deque<std::thread> threads;
-  std::function<std::function<void()>(std::function<void()>)> lend() {
+  cutting::Beside lend() {
     return [this](std::function<void()> job) -> std::function<void()> {
       threads.emplace_back(std::move(job));
       std::thread* t = &threads.back();

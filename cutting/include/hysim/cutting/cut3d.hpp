@@ -25,6 +25,7 @@
 #include <functional>
 #include <vector>
 
+#include "hysim/cutting/beside.hpp"
 #include "hysim/cutting/cut2d.hpp"  // CutMethod, parseCutMethod, cutMethodName
 #include "hysim/cutting/cut_surface.hpp"
 #include "hysim/cutting/mesh.hpp"
@@ -200,7 +201,7 @@ struct Cut3DOptions {
   // tests, and half of each move iteration of the optimisation (parallel_min_nodes); the
   // result is the same. Empty: everything runs on the calling thread. cut3d waits for each
   // job before it starts the next.
-  std::function<std::function<void()>(std::function<void()>)> beside;
+  Beside beside;
   // Optional (hybrid): the nodes that hold the tissue in place. Given, the pieces the cut
   // cuts off (node-connected parts of the cut mesh with no anchored node, such as a chip
   // the caller removes) are left as the cut made them: the optimisation works on the rest

@@ -9,6 +9,8 @@
 #include <mutex>
 #include <thread>
 
+#include "hysim/cutting/beside.hpp"
+
 namespace hysim::engine {
 
 // The second thread of the passes. It sleeps between passes; begin() wakes it as a pass
@@ -41,7 +43,7 @@ class PassWorker {
   void end() { awake_.store(false, std::memory_order_release); }
   // A Cut3DOptions::beside that runs each job on the worker (kept here until the next
   // begin(); the caller waits for each, as cut3d does, before end()).
-  std::function<std::function<void()>(std::function<void()>)> lend() {
+  cutting::Beside lend() {
     return [this](std::function<void()> job) -> std::function<void()> {
       lent_.push_back(std::move(job));
       const std::int64_t ticket = post(lent_.back());

@@ -6,9 +6,9 @@
 // sim::buildModel); the state remapped (new nodes interpolate position and velocity from
 // their parents with the TopologyChange's weights).
 #include <Eigen/Core>
-#include <functional>
 #include <vector>
 
+#include "hysim/cutting/beside.hpp"
 #include "hysim/cutting/mesh.hpp"
 #include "hysim/cutting/result.hpp"
 #include "hysim/cutting/topology_change.hpp"
@@ -126,7 +126,7 @@ struct CutUpdate3DOptions {
   // (beside the masses); the result is the same to the last bit. Empty: one thread. The
   // jobs must not wait behind the caller (a PassWorker lent from a job on that worker would
   // wait for itself), and one that throws (bad_alloc only) ends the program.
-  std::function<std::function<void()>(std::function<void()>)> beside;
+  cutting::Beside beside;
 };
 
 struct CutUpdate3DReport {
