@@ -2,6 +2,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <functional>
@@ -767,63 +768,85 @@ Status prepareModelAfterCut3D(const Model& model, const cutting::TetMesh& before
     if (mass[j] > 0.0) unknown.push_back(j);
   // Springs: unchanged unless both ends are touched; edges between touched nodes anew.
   // The unchanged ones stay in the model's arrays (compacted in place by the second part,
-  // once nothing can fail); `springs` collects the recomputed ones, which follow them.
-  std::vector<CutUpdate3DPrepared::Spring>& springs = prepared->springs;
+  // once nothing can fail); prepared->springs collects the recomputed ones, which follow them.
   // Per touched node a in increasing order, the edges (a, b) to touched nodes b > a, in
   // increasing b (buildModel's order), each summing its tets in increasing order (as
   // buildModel does): a's tet list is in increasing order, so each b's sums are accumulated
   // in that order, in a small table of a's neighbours (`slot`: b -> entry, -1 otherwise).
+  // The touched nodes go in chunks (kSpringChunk nodes each, taken in turn from `next_chunk`
+  // by whichever thread is free: the thread lent, and this one once the masses are done),
+  // each into its own list; the lists in chunk order are the springs in the order of one pass.
+  // (Each thread has its own scratch: `slot` and `edge_sums`.)
   struct EdgeSum {
     int b;
     double ev, bev;
   };
-  std::vector<EdgeSum> edge_sums;
-  std::vector<int> slot(static_cast<size_t>(N1), -1);
-  int recomputed = 0;
-  Status springs_status;
-  // (Beside the masses' correction: it reads the volumes the lumped priors computed, every tet
-  // around a touched node, and writes only `springs`, recomputed and springs_status.)
-  const std::function<void()> springsJob = [&] {
-    // About 7 edges a node towards higher-numbered neighbours in a tet mesh: room for most
-    // cuts without regrowing (each regrowth copies the springs collected so far).
-    springs.reserve(8 * static_cast<size_t>(rep.touched_nodes));
-    for (int r = 0; r < rep.touched_nodes; ++r) {
-      const int a = region_nodes[r];
-      edge_sums.clear();
-      for (int e = off[a]; e < off[a + 1]; ++e) {
-        const int t = around[e];
-        const Material* mat = nullptr;
-        double vol = 0.0;
-        for (int k = 0; k < 4; ++k) {
-          const int b = node(t, k);
-          if (b <= a || !touched[b]) continue;
-          if (mat == nullptr) {
-            vol = volumeOf(t);
-            if (!(vol > 0.0)) {
-              springs_status = Error{"tet " + std::to_string(t) + " has non-positive volume " + std::to_string(vol)};
-              return;
+  struct SpringsScratch {
+    std::vector<EdgeSum> edge_sums;
+    std::vector<int> slot;
+  };
+  constexpr int kSpringChunk = 64;
+  const int num_chunks = (rep.touched_nodes + kSpringChunk - 1) / kSpringChunk;
+  struct SpringChunk {
+    std::vector<CutUpdate3DPrepared::Spring> springs;
+    int bad_tet = -1;  // a tet of non-positive volume met (the chunk stopped there)
+    double bad_volume = 0.0;
+  };
+  std::vector<SpringChunk> chunks(static_cast<size_t>(num_chunks));
+  std::atomic<int> next_chunk{0};
+  // (Reads the volumes the lumped priors computed, every tet around a touched node, and
+  // writes only its own chunks and scratch.)
+  auto springChunks = [&](SpringsScratch& scratch) {
+    std::vector<EdgeSum>& edge_sums = scratch.edge_sums;
+    std::vector<int>& slot = scratch.slot;
+    for (int c = next_chunk.fetch_add(1, std::memory_order_relaxed); c < num_chunks;
+         c = next_chunk.fetch_add(1, std::memory_order_relaxed)) {
+      if (slot.empty()) slot.assign(static_cast<size_t>(N1), -1);
+      SpringChunk& chunk = chunks[c];
+      // About 7 edges a node towards higher-numbered neighbours in a tet mesh.
+      chunk.springs.reserve(8 * kSpringChunk);
+      const int r_end = std::min(rep.touched_nodes, (c + 1) * kSpringChunk);
+      for (int r = c * kSpringChunk; r < r_end && chunk.bad_tet < 0; ++r) {
+        const int a = region_nodes[r];
+        edge_sums.clear();
+        for (int e = off[a]; e < off[a + 1] && chunk.bad_tet < 0; ++e) {
+          const int t = around[e];
+          const Material* mat = nullptr;
+          double vol = 0.0;
+          for (int k = 0; k < 4; ++k) {
+            const int b = node(t, k);
+            if (b <= a || !touched[b]) continue;
+            if (mat == nullptr) {
+              vol = volumeOf(t);
+              if (!(vol > 0.0)) {
+                chunk.bad_tet = t;
+                chunk.bad_volume = vol;
+                break;
+              }
+              mat = &model.materials[material[t]];
             }
-            mat = &model.materials[material[t]];
+            int& at = slot[b];
+            if (at < 0) {
+              at = static_cast<int>(edge_sums.size());
+              edge_sums.push_back({b, 0.0, 0.0});
+            }
+            EdgeSum& sum = edge_sums[at];
+            sum.ev += mat->young_modulus_pa * vol;
+            sum.bev += mat->stiffness_damping_s * mat->young_modulus_pa * vol;
           }
-          int& at = slot[b];
-          if (at < 0) {
-            at = static_cast<int>(edge_sums.size());
-            edge_sums.push_back({b, 0.0, 0.0});
-          }
-          EdgeSum& sum = edge_sums[at];
-          sum.ev += mat->young_modulus_pa * vol;
-          sum.bev += mat->stiffness_damping_s * mat->young_modulus_pa * vol;
         }
-      }
-      for (const EdgeSum& sum : edge_sums) slot[sum.b] = -1;
-      std::sort(edge_sums.begin(), edge_sums.end(), [](const EdgeSum& x, const EdgeSum& y) { return x.b < y.b; });
-      for (const EdgeSum& sum : edge_sums) {
-        const double len = (after.X.row(sum.b) - after.X.row(a)).norm();
-        springs.push_back({a, sum.b, len, sum.ev / (len * len), sum.bev / (len * len)});
-        ++recomputed;
+        for (const EdgeSum& sum : edge_sums) slot[sum.b] = -1;
+        if (chunk.bad_tet >= 0) break;
+        std::sort(edge_sums.begin(), edge_sums.end(), [](const EdgeSum& x, const EdgeSum& y) { return x.b < y.b; });
+        for (const EdgeSum& sum : edge_sums) {
+          const double len = (after.X.row(sum.b) - after.X.row(a)).norm();
+          chunk.springs.push_back({a, sum.b, len, sum.ev / (len * len), sum.bev / (len * len)});
+        }
       }
     }
   };
+  SpringsScratch lent_scratch, own_scratch;
+  const std::function<void()> springsJob = [&] { springChunks(lent_scratch); };
   cutting::LentJob springs_lent(options.beside, springsJob);
   if (!unknown.empty()) {
     Eigen::Vector3d lo = after.X.row(unknown[0]).transpose(), hi = lo;
@@ -853,16 +876,22 @@ Status prepareModelAfterCut3D(const Model& model, const cutting::TetMesh& before
   }
   bool masses_ok = true;
   for (int j : region_nodes) masses_ok = masses_ok && mass[j] >= 0.0 && std::isfinite(mass[j]);
+  springChunks(own_scratch);  // the chunks the lent thread has not taken yet
   springs_lent.join();
-  if (!masses_ok) {
-    prepared->springs.clear();  // (as before the springs were lent: nothing of a failed first part)
-    return Error{"updateModelAfterCut3D: non-finite or negative mass"};
+  if (!masses_ok) return Error{"updateModelAfterCut3D: non-finite or negative mass"};
+  // The chunks in order: the first tet of non-positive volume a single pass would meet, or
+  // the springs in that pass's order.
+  size_t recomputed = 0;
+  for (const SpringChunk& chunk : chunks) {
+    if (chunk.bad_tet >= 0)
+      return Error{"tet " + std::to_string(chunk.bad_tet) + " has non-positive volume " +
+                   std::to_string(chunk.bad_volume)};
+    recomputed += chunk.springs.size();
   }
-  if (!springs_status.ok()) {
-    prepared->springs.clear();
-    return springs_status;
-  }
-  rep.springs_recomputed = recomputed;
+  std::vector<CutUpdate3DPrepared::Spring>& springs = prepared->springs;
+  springs.reserve(recomputed);
+  for (const SpringChunk& chunk : chunks) springs.insert(springs.end(), chunk.springs.begin(), chunk.springs.end());
+  rep.springs_recomputed = static_cast<int>(recomputed);
   prepared->num_nodes_before = N0;
   prepared->mass = std::move(mass);
   prepared->touched = std::move(touched);

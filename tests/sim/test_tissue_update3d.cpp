@@ -365,11 +365,13 @@ TEST(TissueUpdate3D, TwoPartUpdateIsTheOneCallUpdate) {
 
 // The first part with a thread lent (CutUpdate3DOptions::beside: the element comparison and
 // the springs on it) gives the same model to the last bit, for the SIMD and the baseline
-// forms, after a complete and after partial cuts (a small one in a larger box, whose masses
+// forms, after complete cuts (in the larger box the touched nodes' springs make many chunks,
+// which both threads take) and after partial cuts (a small one in a larger box, whose masses
 // sum over the touched nodes' tets rather than over all tets); every job it lends is waited
-// for, also when it fails (with only the comparison lent, and with the springs lent). Data
-// races between the two threads are for ThreadSanitizer to find; here they would show as a
-// different model.
+// for, also when it fails (with only the comparison lent, and with the springs lent; a tet of
+// non-positive volume in several chunks: the error names the one a single pass meets first).
+// Data races between the two threads are for ThreadSanitizer to find; here they would show as
+// a different model.
 TEST(TissueUpdate3D, WorkBesideGivesTheSameModel) {
   const cutting::TetMesh box6 = testing::boxTetMesh(6, 6, 6, 1.0);
   const cutting::TetMesh box12 = testing::boxTetMesh(12, 12, 12, 1.0);
@@ -387,7 +389,7 @@ TEST(TissueUpdate3D, WorkBesideGivesTheSameModel) {
   };
   const cutting::CutSurface partial = strip(-1, 3.5, -1, 7, 2.6), small = strip(-1, 2.5, 4.3, 7.7, 6.55);
   const std::pair<const cutting::TetMesh*, const cutting::CutSurface*> cases[] = {
-      {&box6, &complete}, {&box6, &partial}, {&box12, &small}};
+      {&box6, &complete}, {&box6, &partial}, {&box12, &small}, {&box12, &complete}};
   for (const auto& [mesh_ptr, surface] : cases) {
     const cutting::TetMesh& mesh = *mesh_ptr;
     std::vector<int> fixed;
@@ -421,6 +423,9 @@ TEST(TissueUpdate3D, WorkBesideGivesTheSameModel) {
       EXPECT_EQ(pa.report.springs_recomputed, pb.report.springs_recomputed);
       EXPECT_GT(pa.report.springs_recomputed, 0);
       EXPECT_LT(pa.report.touched_nodes, r->mesh.numNodes());
+      if (mesh_ptr == &box12 && surface == &complete) {
+        EXPECT_GT(pa.report.touched_nodes, 4 * 64);  // (the springs' chunks are 64 nodes)
+      }
       CutUpdate3DReport ra, rb;
       ASSERT_TRUE(finishModelAfterCut3D(alone, r->mesh, r->change, flags, {}, {}, pa, &ra).ok());
       ASSERT_TRUE(finishModelAfterCut3D(beside, r->mesh, r->change, flags, {}, {}, pb, &rb).ok());
@@ -459,6 +464,30 @@ TEST(TissueUpdate3D, WorkBesideGivesTheSameModel) {
       EXPECT_EQ(threads.jobs(), 2);
       for (const std::thread& t : threads.threads) EXPECT_FALSE(t.joinable());
       EXPECT_TRUE(failed.springs.empty());
+    }
+    if (mesh_ptr == &box12 && surface == &complete) {
+      // Every element the cut kept turned inside out (two nodes swapped: the same element to
+      // the comparison, of negative volume): the springs of the touched nodes meet such tets
+      // in many chunks; the error is the one of one pass, with or without the thread.
+      cutting::TetMesh inverted = r->mesh;
+      std::vector<std::uint8_t> added(static_cast<size_t>(inverted.numTets()), 0);
+      for (int t : r->change.added_elements) added[t] = 1;
+      for (int t = 0; t < inverted.numTets(); ++t)
+        if (!added[t]) std::swap(inverted.T(t, 0), inverted.T(t, 1));
+      CutUpdate3DPrepared alone, beside;
+      const Status one = prepareModelAfterCut3D(*built, mesh, inverted, r->change, {}, &alone);
+      testing::ThreadBeside threads;
+      CutUpdate3DOptions options;
+      options.beside = threads.lend();
+      const Status two = prepareModelAfterCut3D(*built, mesh, inverted, r->change, options, &beside);
+      ASSERT_FALSE(one.ok());
+      ASSERT_FALSE(two.ok());
+      EXPECT_NE(one.error().find("non-positive volume"), std::string::npos) << one.error();
+      EXPECT_EQ(one.error(), two.error());
+      EXPECT_EQ(threads.jobs(), 2);
+      for (const std::thread& t : threads.threads) EXPECT_FALSE(t.joinable());
+      EXPECT_TRUE(alone.springs.empty());
+      EXPECT_TRUE(beside.springs.empty());
     }
   }
 }
