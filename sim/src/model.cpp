@@ -92,13 +92,19 @@ void fillStepSprings(Model& m, int count) {
   // node's entries in increasing spring order, off[i] ending at their start (no cursor array).
   for (int i = 1; i < n; ++i) off[i] += off[i - 1];
   if (n > 0) off[n] = off[n - 1];
-  st.a.resize(count);
-  st.b.resize(count);
-  st.rest_length.resize(count);
-  st.stiffness.resize(count);
-  st.damping.resize(count);
-  st.incident.resize(off[n]);
-  st.sign.resize(off[n]);
+  // Every entry is written below: an array that must grow is emptied first, so that growing
+  // does not copy its old contents.
+  auto size = [](auto& v, size_t len) {
+    if (len > v.capacity()) v.clear();
+    v.resize(len);
+  };
+  size(st.a, count);
+  size(st.b, count);
+  size(st.rest_length, count);
+  size(st.stiffness, count);
+  size(st.damping, count);
+  size(st.incident, off[n]);
+  size(st.sign, off[n]);
   std::int32_t* const step_a = st.a.data();
   std::int32_t* const step_b = st.b.data();
   double* const rest = st.rest_length.data();
