@@ -1407,8 +1407,12 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
       region.edge_length += (input.X.row(ce.a) - input.X.row(ce.b)).norm() / static_cast<double>(crossed.size());
     region.seeds.insert(region.seeds.end(), moved.begin(), moved.end());
     // The input's lists, patched to the output mesh (the rows the cut wrote, the appended
-    // tets); the optimisation takes them over.
-    patchStarLists(input.T, out.T, N1, std::move(w.changedTets), &stars);
+    // tets); the optimisation takes them over. Beside them (both only read `out`), the mesh's
+    // volume for the optimisation's budgets.
+    {
+      LentJob volumeJob(options.beside, [&out, &region] { region.mesh_volume = optimizeMeshVolume(out); });
+      patchStarLists(input.T, out.T, N1, std::move(w.changedTets), &stars);
+    }
 #ifdef HYSIM_CHECK_EXACT
     {
       StarLists full;

@@ -6,6 +6,7 @@
 #include <bit>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <new>
 #include <utility>
@@ -63,12 +64,18 @@ void buildStarLists(const Tets& T, int numNodes, StarLists* lists);
 void patchStarLists(const Tets& before, const Tets& after, int numNodesAfter, std::vector<std::int32_t> changed,
                     StarLists* lists);
 
+// The mesh's volume as optimizeAroundCut's volume budgets take it (tet volumes added in
+// index order).
+double optimizeMeshVolume(const TetMesh& mesh);
+
 struct CutRegion {
   const CutSurface* surface = nullptr;
   double eps = 0;                       // on-surface tolerance (absolute)
   std::vector<std::int32_t> seeds;      // nodes the cut created, moved or separated
   std::vector<std::uint8_t> on_cut;     // #N of the output mesh: node lies on the cut
   double edge_length = 0;               // mean length of the crossed edges (the local mesh size)
+  // Optional: optimizeMeshVolume(mesh) computed beforehand (NaN: optimizeAroundCut computes it).
+  double mesh_volume = std::numeric_limits<double>::quiet_NaN();
   // Optional: the output mesh's node -> tet lists (cut3d: the input's, patched where the cut
   // changed tets), which optimizeAroundCut takes over (moved from) instead of building them.
   StarLists* stars = nullptr;
