@@ -116,9 +116,9 @@ struct Constraint {
 }  // namespace
 
 // The mesh's volume as the optimisation's budgets take it: tetVolume's value per tet, in
-// scalars without the out-of-line cross product (tetVolumeHere), added in index order.
-// Two tets at a time in SSE2 lanes: each lane does tetVolume6Here's operations, / 6.0, so it
-// holds tetVolumeHere's value; the values are added one after the other, in index order.
+// scalars without the out-of-line cross product (tetVolumeHere), added in index order. Two
+// tets at a time in SSE2 lanes: each lane does tetVolume6Here's operations, / 6.0, so it
+// holds tetVolumeHere's value.
 double optimizeMeshVolume(const TetMesh& mesh) {
   double meshVolume = 0;
   const int M = mesh.numTets();
