@@ -697,10 +697,6 @@ Status prepareModelAfterCut3D(const Model& model, const cutting::TetMesh& before
     if (std::isnan(volume[t])) volume[t] = computeVolume(t);
     return volume[t];
   };
-  auto volumeOf = [&](int t) {  // tetVolume without writing the cache (for the springs job)
-    const double v = volume[t];
-    return std::isnan(v) ? computeVolume(t) : v;
-  };
 
   compare.join();
   auto touchTet = [&](int t) {
@@ -712,6 +708,7 @@ Status prepareModelAfterCut3D(const Model& model, const cutting::TetMesh& before
     if (i >= 0 && i < N1)
       for (int e = off[i]; e < off[i + 1]; ++e) touchTet(around[e]);  // their volumes changed
   std::vector<int> region_nodes;
+  region_nodes.reserve(static_cast<size_t>(N1));  // (never reallocated: see the springs below)
   for (int i = 0; i < N1; ++i)
     if (touched[i]) region_nodes.push_back(i);
   rep.touched_nodes = static_cast<int>(region_nodes.size());
@@ -719,6 +716,96 @@ Status prepareModelAfterCut3D(const Model& model, const cutting::TetMesh& before
     if (t >= 0 && t < T1 && !(tetVolume(t) > 0.0))
       return Error{"tet " + std::to_string(t) + " has non-positive volume " + std::to_string(tetVolume(t))};
   }
+  // Springs: unchanged unless both ends are touched; edges between touched nodes anew.
+  // The unchanged ones stay in the model's arrays (compacted in place by the second part,
+  // once nothing can fail); prepared->springs collects the recomputed ones, which follow them.
+  // Per touched node a in increasing order, the edges (a, b) to touched nodes b > a, in
+  // increasing b (buildModel's order), each summing its tets in increasing order (as
+  // buildModel does): a's tet list is in increasing order, so each b's sums are accumulated
+  // in that order, in a small table of a's neighbours (`slot`: b -> entry, -1 otherwise).
+  // The touched nodes go in chunks (kSpringChunk nodes each, taken in turn from `next_chunk`
+  // by whichever thread is free: the thread lent, from here on beside the rings and the
+  // masses, and this one once the masses are done), each into its own list; the lists in
+  // chunk order are the springs in the order of one pass. (Each thread has its own scratch:
+  // `slot` and `edge_sums`.)
+  struct EdgeSum {
+    int b;
+    double ev, bev;
+  };
+  struct SpringsScratch {
+    bool cached;  // volumes through the cache (this thread's scratch only)
+    std::vector<EdgeSum> edge_sums;
+    std::vector<int> slot;
+  };
+  constexpr int kSpringChunk = 64;
+  const int num_chunks = (rep.touched_nodes + kSpringChunk - 1) / kSpringChunk;
+  struct SpringChunk {
+    std::vector<CutUpdate3DPrepared::Spring> springs;
+    int bad_tet = -1;  // a tet of non-positive volume met (the chunk stopped there)
+    double bad_volume = 0.0;
+  };
+  std::vector<SpringChunk> chunks(static_cast<size_t>(num_chunks));
+  const int* const touched_list = region_nodes.data();
+  std::atomic<int> next_chunk{0};
+  // (Reads the touched nodes (the first entries of region_nodes, which the rings below only
+  // append to: room for every node is reserved, so they never move), the node -> tets lists,
+  // the materials and the positions; on the thread lent it computes its tets' volumes itself
+  // (the same arithmetic as the cached ones, which this thread writes meanwhile); writes only
+  // its own chunks and scratch.)
+  auto springChunks = [&](SpringsScratch& scratch) {
+    std::vector<EdgeSum>& edge_sums = scratch.edge_sums;
+    std::vector<int>& slot = scratch.slot;
+    for (int c = next_chunk.fetch_add(1, std::memory_order_relaxed); c < num_chunks;
+         c = next_chunk.fetch_add(1, std::memory_order_relaxed)) {
+      if (slot.empty()) slot.assign(static_cast<size_t>(N1), -1);
+      SpringChunk& chunk = chunks[c];
+      // About 7 edges a node towards higher-numbered neighbours in a tet mesh.
+      chunk.springs.reserve(8 * kSpringChunk);
+      const int r_end = std::min(rep.touched_nodes, (c + 1) * kSpringChunk);
+      for (int r = c * kSpringChunk; r < r_end && chunk.bad_tet < 0; ++r) {
+        const int a = touched_list[r];
+        edge_sums.clear();
+        for (int e = off[a]; e < off[a + 1] && chunk.bad_tet < 0; ++e) {
+          const int t = around[e];
+          const Material* mat = nullptr;
+          double vol = 0.0;
+          for (int k = 0; k < 4; ++k) {
+            const int b = node(t, k);
+            if (b <= a || !touched[b]) continue;
+            if (mat == nullptr) {
+              vol = scratch.cached ? tetVolume(t) : computeVolume(t);
+              if (!(vol > 0.0)) {
+                chunk.bad_tet = t;
+                chunk.bad_volume = vol;
+                break;
+              }
+              mat = &model.materials[material[t]];
+            }
+            int& at = slot[b];
+            if (at < 0) {
+              at = static_cast<int>(edge_sums.size());
+              edge_sums.push_back({b, 0.0, 0.0});
+            }
+            EdgeSum& sum = edge_sums[at];
+            sum.ev += mat->young_modulus_pa * vol;
+            sum.bev += mat->stiffness_damping_s * mat->young_modulus_pa * vol;
+          }
+        }
+        for (const EdgeSum& sum : edge_sums) slot[sum.b] = -1;
+        if (chunk.bad_tet >= 0) break;
+        std::sort(edge_sums.begin(), edge_sums.end(), [](const EdgeSum& x, const EdgeSum& y) { return x.b < y.b; });
+        for (const EdgeSum& sum : edge_sums) {
+          const double len = (after.X.row(sum.b) - after.X.row(a)).norm();
+          chunk.springs.push_back({a, sum.b, len, sum.ev / (len * len), sum.bev / (len * len)});
+        }
+      }
+    }
+  };
+  // (Without a thread lent, this thread takes every chunk once the masses are done, as
+  // before, reading the volumes the lumped priors cached.)
+  SpringsScratch lent_scratch{false, {}, {}}, own_scratch{true, {}, {}};
+  const std::function<void()> springsJob = [&] { springChunks(lent_scratch); };
+  cutting::LentJob springs_lent(options.beside, options.beside ? springsJob : [] {});
   // Mass region: the touched nodes and rings of neighbours (a cut's nodes lie near one
   // surface, where the second moments across it are badly conditioned).
   std::vector<std::uint8_t> region = touched;
@@ -766,88 +853,6 @@ Status prepareModelAfterCut3D(const Model& model, const cutting::TetMesh& before
   }
   for (int j : region_nodes)
     if (mass[j] > 0.0) unknown.push_back(j);
-  // Springs: unchanged unless both ends are touched; edges between touched nodes anew.
-  // The unchanged ones stay in the model's arrays (compacted in place by the second part,
-  // once nothing can fail); prepared->springs collects the recomputed ones, which follow them.
-  // Per touched node a in increasing order, the edges (a, b) to touched nodes b > a, in
-  // increasing b (buildModel's order), each summing its tets in increasing order (as
-  // buildModel does): a's tet list is in increasing order, so each b's sums are accumulated
-  // in that order, in a small table of a's neighbours (`slot`: b -> entry, -1 otherwise).
-  // The touched nodes go in chunks (kSpringChunk nodes each, taken in turn from `next_chunk`
-  // by whichever thread is free: the thread lent, and this one once the masses are done),
-  // each into its own list; the lists in chunk order are the springs in the order of one pass.
-  // (Each thread has its own scratch: `slot` and `edge_sums`.)
-  struct EdgeSum {
-    int b;
-    double ev, bev;
-  };
-  struct SpringsScratch {
-    std::vector<EdgeSum> edge_sums;
-    std::vector<int> slot;
-  };
-  constexpr int kSpringChunk = 64;
-  const int num_chunks = (rep.touched_nodes + kSpringChunk - 1) / kSpringChunk;
-  struct SpringChunk {
-    std::vector<CutUpdate3DPrepared::Spring> springs;
-    int bad_tet = -1;  // a tet of non-positive volume met (the chunk stopped there)
-    double bad_volume = 0.0;
-  };
-  std::vector<SpringChunk> chunks(static_cast<size_t>(num_chunks));
-  std::atomic<int> next_chunk{0};
-  // (Reads the volumes the lumped priors computed, every tet around a touched node, and
-  // writes only its own chunks and scratch.)
-  auto springChunks = [&](SpringsScratch& scratch) {
-    std::vector<EdgeSum>& edge_sums = scratch.edge_sums;
-    std::vector<int>& slot = scratch.slot;
-    for (int c = next_chunk.fetch_add(1, std::memory_order_relaxed); c < num_chunks;
-         c = next_chunk.fetch_add(1, std::memory_order_relaxed)) {
-      if (slot.empty()) slot.assign(static_cast<size_t>(N1), -1);
-      SpringChunk& chunk = chunks[c];
-      // About 7 edges a node towards higher-numbered neighbours in a tet mesh.
-      chunk.springs.reserve(8 * kSpringChunk);
-      const int r_end = std::min(rep.touched_nodes, (c + 1) * kSpringChunk);
-      for (int r = c * kSpringChunk; r < r_end && chunk.bad_tet < 0; ++r) {
-        const int a = region_nodes[r];
-        edge_sums.clear();
-        for (int e = off[a]; e < off[a + 1] && chunk.bad_tet < 0; ++e) {
-          const int t = around[e];
-          const Material* mat = nullptr;
-          double vol = 0.0;
-          for (int k = 0; k < 4; ++k) {
-            const int b = node(t, k);
-            if (b <= a || !touched[b]) continue;
-            if (mat == nullptr) {
-              vol = volumeOf(t);
-              if (!(vol > 0.0)) {
-                chunk.bad_tet = t;
-                chunk.bad_volume = vol;
-                break;
-              }
-              mat = &model.materials[material[t]];
-            }
-            int& at = slot[b];
-            if (at < 0) {
-              at = static_cast<int>(edge_sums.size());
-              edge_sums.push_back({b, 0.0, 0.0});
-            }
-            EdgeSum& sum = edge_sums[at];
-            sum.ev += mat->young_modulus_pa * vol;
-            sum.bev += mat->stiffness_damping_s * mat->young_modulus_pa * vol;
-          }
-        }
-        for (const EdgeSum& sum : edge_sums) slot[sum.b] = -1;
-        if (chunk.bad_tet >= 0) break;
-        std::sort(edge_sums.begin(), edge_sums.end(), [](const EdgeSum& x, const EdgeSum& y) { return x.b < y.b; });
-        for (const EdgeSum& sum : edge_sums) {
-          const double len = (after.X.row(sum.b) - after.X.row(a)).norm();
-          chunk.springs.push_back({a, sum.b, len, sum.ev / (len * len), sum.bev / (len * len)});
-        }
-      }
-    }
-  };
-  SpringsScratch lent_scratch, own_scratch;
-  const std::function<void()> springsJob = [&] { springChunks(lent_scratch); };
-  cutting::LentJob springs_lent(options.beside, springsJob);
   if (!unknown.empty()) {
     Eigen::Vector3d lo = after.X.row(unknown[0]).transpose(), hi = lo;
     for (int j : unknown) {
