@@ -67,83 +67,121 @@ double topTridiagonalEigenvalue(const Eigen::VectorXd& diag, const Eigen::Vector
 
 namespace {
 
-// The Lanczos operator's AVX2 form (see topEigenvalue): the same IEEE operations in the same
-// order as the scalar loop, 4 lanes per node (x, y, z, pad), so the results are the same to
-// the last bit (no FMA: the AVX2 build does not enable it, and ISO C++ mode keeps contraction
-// off). The pad lanes carry values that are never read back.
-struct alignas(32) FreeSpring4 {
-  double wa[4], wb[4];  // pad lane 0
-  std::int64_t a, b;    // 4 * local index
+// The Lanczos operator (see topEigenvalue), A u = r (K (r u)) with r = M^-1/2 per node: y = r u,
+// z' = H y + the springs' terms, z = r z'. A spring between free nodes is kept at its end of
+// lower local index k (its group) as w = sqrt(k_s) d, d the unit direction from k to its other
+// end b, and b's 4-lane offset; its term is t = w.(y_b - y_k), z'_k -= t w, z'_b += t w. Per
+// node (4 lanes: x, y, z, pad 0) y and z' live in y4 and z4.
+// Groups in increasing k: z'_k is final once its group is done (every other spring with k at
+// an end came in an earlier group), so it is kept in registers through its group and scaled
+// into z at the end. 32 bytes a spring: the loop streams them once a step.
+struct alignas(32) SpringY {
+  double w[3];
+  std::int32_t b;  // 4 * local index
+  std::int32_t unused;
 };
+static_assert(sizeof(SpringY) == 32);
+
+// The operator in scalars: `cols` 12 per node (the three columns of the symmetric held block,
+// the sum of w w^T over the node's springs to held nodes, pad 0), `r` per node, group k's
+// springs springs[group[k], group[k + 1]).
+void applySpringsScalar(int count, const double* u, double* z, const double* cols, const double* r,
+                        const SpringY* springs, const int* group, double* y4, double* z4) {
+  for (int k = 0; k < count; ++k) {
+    const double rk = r[k];
+    const double x = rk * u[3 * k], y = rk * u[3 * k + 1], w = rk * u[3 * k + 2];
+    double* yk = y4 + 4 * k;
+    yk[0] = x;
+    yk[1] = y;
+    yk[2] = w;
+    yk[3] = 0.0;
+    const double* c = cols + 12 * k;
+    double* zk = z4 + 4 * k;
+    zk[0] = (c[0] * x + c[4] * y) + c[8] * w;
+    zk[1] = (c[1] * x + c[5] * y) + c[9] * w;
+    zk[2] = (c[2] * x + c[6] * y) + c[10] * w;
+    zk[3] = 0.0;
+  }
+  for (int k = 0; k < count; ++k) {
+    const double* yk = y4 + 4 * k;
+    double acc[3] = {z4[4 * k], z4[4 * k + 1], z4[4 * k + 2]};
+    for (int i = group[k]; i < group[k + 1]; ++i) {
+      const SpringY& s = springs[i];
+      const double* yb = y4 + s.b;
+      const double t = (s.w[0] * (yb[0] - yk[0]) + s.w[1] * (yb[1] - yk[1])) + s.w[2] * (yb[2] - yk[2]);
+      double* zb = z4 + s.b;
+      for (int c = 0; c < 3; ++c) {
+        acc[c] = acc[c] - t * s.w[c];
+        zb[c] = zb[c] + t * s.w[c];
+      }
+    }
+    for (int c = 0; c < 3; ++c) z[3 * k + c] = r[k] * acc[c];
+  }
+}
 
 bool lanczosAvx2() {
   static const bool has = __builtin_cpu_supports("avx2");
   return has;
 }
 
-// z = H u + sum over springs: u and z #count x 3 (row-major), `cols` 12 per node (the three
-// columns of the symmetric held block, pad 0), u4 and z4 #count x 4 scratch.
-[[gnu::target("avx2")]] void applyAvx2(int count, const double* u, double* z, const double* cols,
-                                       const FreeSpring4* springs, std::size_t num_springs, double* u4, double* z4) {
+// The same operator in AVX2: the same IEEE operations in the same order per lane as the scalar
+// loop, so the results are the same to the last bit (no FMA: the AVX2 build does not enable
+// it, and ISO C++ mode keeps contraction off). Pad lanes hold zeros.
+[[gnu::target("avx2")]] void applySpringsAvx2(int count, const double* u, double* z, const double* cols,
+                                              const double* r, const SpringY* springs, const int* group, double* y4,
+                                              double* z4) {
   const __m256i three = _mm256_set_epi64x(0, -1, -1, -1);
+  const __m256d zero = _mm256_setzero_pd();
   for (int k = 0; k < count; ++k) {
-    const double* uk = u + 3 * k;
-    _mm256_storeu_pd(u4 + 4 * k, _mm256_maskload_pd(uk, three));
+    const __m256d rk = _mm256_broadcast_sd(r + k);
+    const __m256d y = _mm256_mul_pd(rk, _mm256_maskload_pd(u + 3 * k, three));
+    _mm256_storeu_pd(y4 + 4 * k, y);
     const double* c = cols + 12 * k;
-    // (h0 x + h3 y) + h5 w, (h3 x + h1 y) + h4 w, (h5 x + h4 y) + h2 w
-    const __m256d xy = _mm256_add_pd(_mm256_mul_pd(_mm256_loadu_pd(c), _mm256_broadcast_sd(uk)),
-                                     _mm256_mul_pd(_mm256_loadu_pd(c + 4), _mm256_broadcast_sd(uk + 1)));
-    _mm256_storeu_pd(z4 + 4 * k, _mm256_add_pd(xy, _mm256_mul_pd(_mm256_loadu_pd(c + 8), _mm256_broadcast_sd(uk + 2))));
+    // (c0 x + c4 y) + c8 w per lane
+    const __m256d xy = _mm256_add_pd(_mm256_mul_pd(_mm256_loadu_pd(c), _mm256_permute4x64_pd(y, 0x00)),
+                                     _mm256_mul_pd(_mm256_loadu_pd(c + 4), _mm256_permute4x64_pd(y, 0x55)));
+    _mm256_storeu_pd(z4 + 4 * k, _mm256_add_pd(xy, _mm256_mul_pd(_mm256_loadu_pd(c + 8), _mm256_permute4x64_pd(y, 0xAA))));
   }
-  // Two springs at a time: their t from u (read only) in one set of shuffles, then their
-  // updates of z in spring order (the same sums in the same order as one at a time).
-  std::size_t i = 0;
-  for (; i + 2 <= num_springs; i += 2) {
-    const FreeSpring4& f1 = springs[i];
-    const FreeSpring4& f2 = springs[i + 1];
-    const __m256d wa1 = _mm256_load_pd(f1.wa), wb1 = _mm256_load_pd(f1.wb);
-    const __m256d wa2 = _mm256_load_pd(f2.wa), wb2 = _mm256_load_pd(f2.wb);
-    const __m256d pa1 = _mm256_mul_pd(wa1, _mm256_loadu_pd(u4 + f1.a));
-    const __m256d pb1 = _mm256_mul_pd(wb1, _mm256_loadu_pd(u4 + f1.b));
-    const __m256d pa2 = _mm256_mul_pd(wa2, _mm256_loadu_pd(u4 + f2.a));
-    const __m256d pb2 = _mm256_mul_pd(wb2, _mm256_loadu_pd(u4 + f2.b));
-    const __m256d lo1 = _mm256_unpacklo_pd(pb1, pa1);  // pb0 pa0 pb2 pa2 (spring 1)
-    const __m256d hi1 = _mm256_unpackhi_pd(pb1, pa1);  // pb1 pa1 pb3 pa3
-    const __m256d lo2 = _mm256_unpacklo_pd(pb2, pa2);
-    const __m256d hi2 = _mm256_unpackhi_pd(pb2, pa2);
-    // ((pb0 + pb1) + pb2, (pa0 + pa1) + pa2) of spring 1 in the low half, of spring 2 in the
-    // high half; then each half's difference
-    const __m256d sums = _mm256_add_pd(
-        _mm256_add_pd(_mm256_permute2f128_pd(lo1, lo2, 0x20), _mm256_permute2f128_pd(hi1, hi2, 0x20)),
-        _mm256_permute2f128_pd(lo1, lo2, 0x31));
-    const __m256d diff = _mm256_hsub_pd(sums, sums);
-    const __m256d t1 = _mm256_permute4x64_pd(diff, 0x00), t2 = _mm256_permute4x64_pd(diff, 0xAA);
-    double* za = z4 + f1.a;
-    double* zb = z4 + f1.b;
-    _mm256_storeu_pd(za, _mm256_sub_pd(_mm256_loadu_pd(za), _mm256_mul_pd(t1, wa1)));
-    _mm256_storeu_pd(zb, _mm256_add_pd(_mm256_loadu_pd(zb), _mm256_mul_pd(t1, wb1)));
-    za = z4 + f2.a;
-    zb = z4 + f2.b;
-    _mm256_storeu_pd(za, _mm256_sub_pd(_mm256_loadu_pd(za), _mm256_mul_pd(t2, wa2)));
-    _mm256_storeu_pd(zb, _mm256_add_pd(_mm256_loadu_pd(zb), _mm256_mul_pd(t2, wb2)));
+  for (int k = 0; k < count; ++k) {
+    const __m256d yk = _mm256_loadu_pd(y4 + 4 * k);
+    __m256d acc = _mm256_loadu_pd(z4 + 4 * k);
+    int i = group[k];
+    const int end = group[k + 1];
+    // Two springs at a time: their t in one set of shuffles (y is read only; their far ends
+    // differ), then their updates in spring order (the same sums in the same order as one at
+    // a time).
+    for (; i + 2 <= end; i += 2) {
+      const SpringY& s1 = springs[i];
+      const SpringY& s2 = springs[i + 1];
+      const __m256d w1 = _mm256_blend_pd(_mm256_load_pd(s1.w), zero, 0x8);  // (lane 3 holds b)
+      const __m256d w2 = _mm256_blend_pd(_mm256_load_pd(s2.w), zero, 0x8);
+      const __m256d p1 = _mm256_mul_pd(w1, _mm256_sub_pd(_mm256_loadu_pd(y4 + s1.b), yk));
+      const __m256d p2 = _mm256_mul_pd(w2, _mm256_sub_pd(_mm256_loadu_pd(y4 + s2.b), yk));
+      // lo + hi = (p1_0 + p1_1, p2_0 + p2_1, p1_2, p2_2); then the halves' sum
+      const __m256d sum = _mm256_add_pd(_mm256_unpacklo_pd(p1, p2), _mm256_unpackhi_pd(p1, p2));
+      const __m128d t = _mm_add_pd(_mm256_castpd256_pd128(sum), _mm256_extractf128_pd(sum, 1));
+      const __m256d tw1 = _mm256_mul_pd(_mm256_broadcastsd_pd(t), w1);
+      const __m256d tw2 = _mm256_mul_pd(_mm256_broadcastsd_pd(_mm_unpackhi_pd(t, t)), w2);
+      acc = _mm256_sub_pd(acc, tw1);
+      double* zb = z4 + s1.b;
+      _mm256_storeu_pd(zb, _mm256_add_pd(_mm256_loadu_pd(zb), tw1));
+      acc = _mm256_sub_pd(acc, tw2);
+      zb = z4 + s2.b;
+      _mm256_storeu_pd(zb, _mm256_add_pd(_mm256_loadu_pd(zb), tw2));
+    }
+    if (i < end) {
+      const SpringY& s1 = springs[i];
+      const __m256d w1 = _mm256_blend_pd(_mm256_load_pd(s1.w), zero, 0x8);
+      const __m256d p1 = _mm256_mul_pd(w1, _mm256_sub_pd(_mm256_loadu_pd(y4 + s1.b), yk));
+      const __m128d lo = _mm256_castpd256_pd128(p1);
+      const __m128d sum01 = _mm_add_sd(lo, _mm_unpackhi_pd(lo, lo));
+      const __m256d tw1 = _mm256_mul_pd(_mm256_broadcastsd_pd(_mm_add_sd(sum01, _mm256_extractf128_pd(p1, 1))), w1);
+      acc = _mm256_sub_pd(acc, tw1);
+      double* zb = z4 + s1.b;
+      _mm256_storeu_pd(zb, _mm256_add_pd(_mm256_loadu_pd(zb), tw1));
+    }
+    _mm256_maskstore_pd(z + 3 * k, three, _mm256_mul_pd(_mm256_broadcast_sd(r + k), acc));
   }
-  for (; i < num_springs; ++i) {
-    const FreeSpring4& fs = springs[i];
-    const __m256d wa = _mm256_load_pd(fs.wa), wb = _mm256_load_pd(fs.wb);
-    double* za = z4 + fs.a;
-    double* zb = z4 + fs.b;
-    const __m256d pa = _mm256_mul_pd(wa, _mm256_loadu_pd(u4 + fs.a));
-    const __m256d pb = _mm256_mul_pd(wb, _mm256_loadu_pd(u4 + fs.b));
-    const __m256d lo = _mm256_unpacklo_pd(pb, pa);  // pb0 pa0 pb2 pa2
-    const __m256d hi = _mm256_unpackhi_pd(pb, pa);  // pb1 pa1 pb3 pa3
-    // ((pb0 + pb1) + pb2, (pa0 + pa1) + pa2), then their difference
-    const __m128d sums = _mm_add_pd(_mm_add_pd(_mm256_castpd256_pd128(lo), _mm256_castpd256_pd128(hi)),
-                                    _mm256_extractf128_pd(lo, 1));
-    const __m256d t = _mm256_broadcastsd_pd(_mm_sub_sd(sums, _mm_unpackhi_pd(sums, sums)));
-    _mm256_storeu_pd(za, _mm256_sub_pd(_mm256_loadu_pd(za), _mm256_mul_pd(t, wa)));
-    _mm256_storeu_pd(zb, _mm256_add_pd(_mm256_loadu_pd(zb), _mm256_mul_pd(t, wb)));
-  }
-  for (int k = 0; k < count; ++k) _mm256_maskstore_pd(z + 3 * k, three, _mm256_loadu_pd(z4 + 4 * k));
 }
 
 // The elements t of `after` that are not the old element old_of[t] with the same nodes in the
@@ -229,8 +267,9 @@ double topEigenvalue(const Model& m, const cutting::Positions& X, const std::vec
   // Scratch kept between calls (per thread): `local` is all -1 between calls (reset below).
   struct Scratch {
     std::vector<int> local;
-    std::vector<FreeSpring4> springs4;
-    std::vector<double> held_block, cols, u4, z4, root_mass;
+    std::vector<SpringY> springs;
+    std::vector<int> group;
+    std::vector<double> cols, y4, z4, inv_root;
   };
   thread_local Scratch scratch;
   std::vector<int>& local = scratch.local;
@@ -243,62 +282,42 @@ double topEigenvalue(const Model& m, const cutting::Positions& X, const std::vec
       for (int node : nodes) local[node] = -1;
     }
   } reset_local{local, nodes};
-  // The operator, with y = M^-1/2 u: a spring between free nodes contributes t = k d.(y_b - y_a)
-  // to z_b along d and its negative to z_a; with w = sqrt(k) d / sqrt(m) at each end that is
-  // t = w_b.u_b - w_a.u_a, z_a -= t w_a, z_b += t w_b. A spring to a held node (y = 0 there)
-  // only adds (w.u_i) w at its free end: summed per node into a symmetric 3x3 block.
-  struct FreeSpring {
-    int a, b;  // 3 * local index
-    double wa[3], wb[3];
-  };
-  std::vector<FreeSpring> springs;
-  std::vector<FreeSpring4>& springs4 = scratch.springs4;  // the AVX2 form
-  springs4.clear();
+  // The operator (see SpringY): with y = M^-1/2 u, a spring between free nodes contributes
+  // t = k d.(y_b - y_a) to z_b along d and its negative to z_a; with w = sqrt(k) d that is
+  // t = w.(y_b - y_a), z_a -= t w, z_b += t w. A spring to a held node (y = 0 there) only adds
+  // (w.y_i) w at its free end: summed per node into a symmetric 3x3 block, kept as its three
+  // columns (`cols`, 12 per node, pad 0). z = M^-1/2 of the sums.
+  std::vector<SpringY>& springs = scratch.springs;
+  springs.clear();
   const bool avx2 = m.options.simd && lanczosAvx2();
-  if (!avx2) springs.reserve(static_cast<size_t>(count) * 7);
-  std::vector<double>& held_block = scratch.held_block;  // xx yy zz xy yz zx per node, zeroed at its turn
-  if (held_block.size() < 6 * static_cast<size_t>(count)) held_block.resize(6 * static_cast<size_t>(count));
-  // The square roots of the nodes' masses, once a node (the same values as taken per spring end).
-  std::vector<double>& root_mass = scratch.root_mass;
-  if (root_mass.size() < static_cast<size_t>(count)) root_mass.resize(static_cast<size_t>(count));
-  for (int k = 0; k < count; ++k) root_mass[k] = std::sqrt(m.mass[nodes[k]]);
+  std::vector<double>& cols = scratch.cols;
+  std::vector<double>& inv_root = scratch.inv_root;
+  if (cols.size() < 12 * static_cast<size_t>(count)) cols.resize(12 * static_cast<size_t>(count));
+  if (inv_root.size() < static_cast<size_t>(count)) inv_root.resize(static_cast<size_t>(count));
+  for (int k = 0; k < count; ++k) inv_root[k] = 1.0 / std::sqrt(m.mass[nodes[k]]);
+  std::vector<int>& group = scratch.group;
+  group.resize(static_cast<size_t>(count) + 1);
   for (int k = 0; k < count; ++k) {
     const int node = nodes[k];
-    std::fill_n(&held_block[6 * static_cast<size_t>(k)], 6, 0.0);  // only node k's own turn adds to it
+    group[k] = static_cast<int>(springs.size());
+    double h[6] = {0, 0, 0, 0, 0, 0};  // xx yy zz xy yz zx
     for (int e = st.node_offset[node]; e < st.node_offset[node + 1]; ++e) {
       const int s = st.incident[e];
       const int a = st.a[s], b = st.b[s];
       // (local is -1 at anchored nodes: `nodes` are free ones, the caller's estimate nodes.)
       const int la = local[a], lb = local[b];
       if (la >= 0 && lb >= 0 && (a == node ? lb : la) < k) continue;  // taken at the other end
-      Eigen::RowVector3d d = X.row(b) - X.row(a);
+      const int other = a == node ? b : a;
+      Eigen::RowVector3d d = X.row(other) - X.row(node);  // (d, w: from this node)
       d /= d.norm();
-      const double sk = std::sqrt(st.stiffness[s]);
+      const Eigen::RowVector3d w = d * std::sqrt(st.stiffness[s]);
       if (la >= 0 && lb >= 0) {
-        FreeSpring fs;
-        fs.a = 3 * la;
-        fs.b = 3 * lb;
-        const double ca = sk / root_mass[la], cb = sk / root_mass[lb];
-        for (int c = 0; c < 3; ++c) {
-          fs.wa[c] = ca * d[c];
-          fs.wb[c] = cb * d[c];
-        }
-        if (avx2) {
-          FreeSpring4 f4;
-          for (int c = 0; c < 3; ++c) {
-            f4.wa[c] = fs.wa[c];
-            f4.wb[c] = fs.wb[c];
-          }
-          f4.wa[3] = f4.wb[3] = 0.0;
-          f4.a = 4 * la;
-          f4.b = 4 * lb;
-          springs4.push_back(f4);
-        } else {
-          springs.push_back(fs);
-        }
+        SpringY sy;
+        for (int c = 0; c < 3; ++c) sy.w[c] = w[c];
+        sy.b = 4 * local[other];
+        sy.unused = 0;
+        springs.push_back(sy);
       } else if (la == k || lb == k) {  // this node free, the other end held
-        const Eigen::RowVector3d w = d * (sk / root_mass[k]);
-        double* h = &held_block[6 * static_cast<size_t>(k)];
         h[0] += w[0] * w[0];
         h[1] += w[1] * w[1];
         h[2] += w[2] * w[2];
@@ -307,50 +326,18 @@ double topEigenvalue(const Model& m, const cutting::Positions& X, const std::vec
         h[5] += w[2] * w[0];
       }
     }
+    const double col[12] = {h[0], h[3], h[5], 0.0, h[3], h[1], h[4], 0.0, h[5], h[4], h[2], 0.0};
+    std::copy(col, col + 12, &cols[12 * static_cast<size_t>(k)]);
   }
+  group[count] = static_cast<int>(springs.size());
   const Eigen::Index n3 = 3 * static_cast<Eigen::Index>(count);
-  std::vector<double>& cols = scratch.cols;
-  std::vector<double>& u4 = scratch.u4;
+  std::vector<double>& y4 = scratch.y4;
   std::vector<double>& z4 = scratch.z4;
-  if (avx2) {
-    if (cols.size() < 12 * static_cast<size_t>(count)) cols.resize(12 * static_cast<size_t>(count));
-    if (u4.size() < 4 * static_cast<size_t>(count)) u4.resize(4 * static_cast<size_t>(count));
-    if (z4.size() < 4 * static_cast<size_t>(count)) z4.resize(4 * static_cast<size_t>(count));
-    for (int k = 0; k < count; ++k) {
-      const double* h = &held_block[6 * static_cast<size_t>(k)];
-      double* c = &cols[12 * static_cast<size_t>(k)];
-      const double col[12] = {h[0], h[3], h[5], 0.0, h[3], h[1], h[4], 0.0, h[5], h[4], h[2], 0.0};
-      std::copy(col, col + 12, c);
-    }
-  }
+  if (y4.size() < 4 * static_cast<size_t>(count)) y4.resize(4 * static_cast<size_t>(count));
+  if (z4.size() < 4 * static_cast<size_t>(count)) z4.resize(4 * static_cast<size_t>(count));
   auto apply = [&](const Eigen::VectorXd& u, Eigen::VectorXd& z) {
-    if (avx2) {
-      applyAvx2(count, u.data(), z.data(), cols.data(), springs4.data(), springs4.size(), u4.data(), z4.data());
-      return;
-    }
-    const double* up = u.data();
-    double* zp = z.data();
-    const double* h = held_block.data();
-    for (int k = 0; k < count; ++k, h += 6) {
-      const double x = up[3 * k], y = up[3 * k + 1], w = up[3 * k + 2];
-      zp[3 * k] = h[0] * x + h[3] * y + h[5] * w;
-      zp[3 * k + 1] = h[3] * x + h[1] * y + h[4] * w;
-      zp[3 * k + 2] = h[5] * x + h[4] * y + h[2] * w;
-    }
-    for (const FreeSpring& fs : springs) {
-      const double* ua = up + fs.a;
-      const double* ub = up + fs.b;
-      const double t = (fs.wb[0] * ub[0] + fs.wb[1] * ub[1] + fs.wb[2] * ub[2]) -
-                       (fs.wa[0] * ua[0] + fs.wa[1] * ua[1] + fs.wa[2] * ua[2]);
-      double* za = zp + fs.a;
-      double* zb = zp + fs.b;
-      za[0] -= t * fs.wa[0];
-      za[1] -= t * fs.wa[1];
-      za[2] -= t * fs.wa[2];
-      zb[0] += t * fs.wb[0];
-      zb[1] += t * fs.wb[1];
-      zb[2] += t * fs.wb[2];
-    }
+    (avx2 ? applySpringsAvx2 : applySpringsScalar)(count, u.data(), z.data(), cols.data(), inv_root.data(),
+                                                   springs.data(), group.data(), y4.data(), z4.data());
   };
   // Start: the alternating pattern of buildModel's power iteration (excites the highest
   // modes), plus the given vector.
