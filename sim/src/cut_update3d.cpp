@@ -147,9 +147,8 @@ bool lanczosAvx2() {
     __m256d acc = _mm256_loadu_pd(z4 + 4 * k);
     int i = group[k];
     const int end = group[k + 1];
-    // Two springs at a time: their t in one set of shuffles (y is read only; their far ends
-    // differ), then their updates in spring order (the same sums in the same order as one at
-    // a time).
+    // Two springs at a time: their t in one set of shuffles (y is read only), then their
+    // updates in spring order (the same sums in the same order as one at a time).
     for (; i + 2 <= end; i += 2) {
       const SpringY& s1 = springs[i];
       const SpringY& s2 = springs[i + 1];
