@@ -305,15 +305,15 @@ double topEigenvalue(const Model& m, const cutting::Positions& X, const std::vec
       const int a = st.a[s], b = st.b[s];
       // (local is -1 at anchored nodes: `nodes` are free ones, the caller's estimate nodes.)
       const int la = local[a], lb = local[b];
-      if (la >= 0 && lb >= 0 && (a == node ? lb : la) < k) continue;  // taken at the other end
-      const int other = a == node ? b : a;
+      const int other = a == node ? b : a, l_other = a == node ? lb : la;
+      if (la >= 0 && lb >= 0 && l_other < k) continue;  // taken at the other end
       Eigen::RowVector3d d = X.row(other) - X.row(node);  // (d, w: from this node)
       d /= d.norm();
       const Eigen::RowVector3d w = d * std::sqrt(st.stiffness[s]);
       if (la >= 0 && lb >= 0) {
         SpringY sy;
         for (int c = 0; c < 3; ++c) sy.w[c] = w[c];
-        sy.b = 4 * local[other];
+        sy.b = 4 * l_other;
         sy.unused = 0;
         springs.push_back(sy);
       } else if (la == k || lb == k) {  // this node free, the other end held
