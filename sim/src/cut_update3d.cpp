@@ -9,6 +9,7 @@
 #include <immintrin.h>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "hysim/sim/tissue_update3d.hpp"
@@ -246,6 +247,24 @@ void lanczosNext(Eigen::Index n, const double* z, double b, double* q, double* c
   (avx2 ? nextAvx2 : nextBaseline)(n, z, b, q, column);
 }
 
+// The springs at each estimate node, in increasing spring order (the order StepSprings lists
+// them in, so that the sums over them are the same to the last bit): those of nodes[k] are
+// spring[e] for first[i] <= e < first[i + 1], with i = nodes[k] (StepSprings' own lists) or
+// i = k (lists of the estimate nodes only), with ends a, b and stiffness k.
+struct NodeSprings {
+  const std::int32_t* first = nullptr;
+  bool per_node = true;
+  const std::int32_t* spring = nullptr;
+  const std::int32_t* a = nullptr;
+  const std::int32_t* b = nullptr;
+  const double* k = nullptr;
+  int begin(int local, int node) const { return first[per_node ? node : local]; }
+  int end(int local, int node) const { return first[(per_node ? node : local) + 1]; }
+  static NodeSprings of(const StepSprings& st) {
+    return {st.node_offset.data(), true, st.incident.data(), st.a.data(), st.b.data(), st.stiffness.data()};
+  }
+};
+
 // Top eigenvalue of M^-1/2 K M^-1/2 (springs linearised along their rest directions) over
 // the free nodes `nodes` (none anchored), every other node held fixed (a principal
 // submatrix), by Lanczos.
@@ -256,13 +275,12 @@ void lanczosNext(Eigen::Index n, const double* z, double b, double* q, double* c
 // block is the previous T; Cauchy interlacing) and stays below the top eigenvalue, so once
 // it is above a value where `decided` holds, so is the value the full iteration would
 // return. Then that Ritz value is returned; the caller uses it only through `decided`.
-double topEigenvalue(const Model& m, const cutting::Positions& X, const std::vector<int>& nodes,
+double topEigenvalue(const Model& m, const NodeSprings& st, const cutting::Positions& X, const std::vector<int>& nodes,
                      const Eigen::MatrixX3d* start, const CutUpdate3DOptions& options, Eigen::MatrixX3d* mode,
                      int* steps_taken, const std::function<bool(double)>* decided) {
   const int count = static_cast<int>(nodes.size());
   if (steps_taken) *steps_taken = 0;
   if (count == 0) return 0.0;
-  const StepSprings& st = m.step_springs;
   // Scratch kept between calls (per thread): `local` is all -1 between calls (reset below).
   struct Scratch {
     std::vector<int> local;
@@ -300,8 +318,8 @@ double topEigenvalue(const Model& m, const cutting::Positions& X, const std::vec
     const int node = nodes[k];
     group[k] = static_cast<int>(springs.size());
     double h[6] = {0, 0, 0, 0, 0, 0};  // xx yy zz xy yz zx
-    for (int e = st.node_offset[node]; e < st.node_offset[node + 1]; ++e) {
-      const int s = st.incident[e];
+    for (int e = st.begin(k, node), e_end = st.end(k, node); e < e_end; ++e) {
+      const int s = st.spring[e];
       const int a = st.a[s], b = st.b[s];
       // (local is -1 at anchored nodes: `nodes` are free ones, the caller's estimate nodes.)
       const int la = local[a], lb = local[b];
@@ -309,7 +327,7 @@ double topEigenvalue(const Model& m, const cutting::Positions& X, const std::vec
       if (la >= 0 && lb >= 0 && l_other < k) continue;  // taken at the other end
       Eigen::RowVector3d d = X.row(other) - X.row(node);  // (d, w: from this node)
       d /= d.norm();
-      const Eigen::RowVector3d w = d * std::sqrt(st.stiffness[s]);
+      const Eigen::RowVector3d w = d * std::sqrt(st.k[s]);
       if (la >= 0 && lb >= 0) {
         SpringY sy;
         for (int c = 0; c < 3; ++c) sy.w[c] = w[c];
@@ -506,18 +524,19 @@ double topEigenvalue(const Model& m, const cutting::Positions& X, const std::vec
 // (a held end's term is dropped, which only lowers the middle sums). One pass over the
 // springs of `nodes` (it stops once above `stop_above`); lambda_max(S_i) is taken from the
 // closed form plus 1e-6 of the trace (its round-off stays far below that).
-double topEigenvalueBound(const Model& m, const cutting::Positions& X, const std::vector<int>& nodes, double stop_above) {
-  const StepSprings& st = m.step_springs;
+double topEigenvalueBound(const Model& m, const NodeSprings& st, const cutting::Positions& X,
+                          const std::vector<int>& nodes, double stop_above) {
   double bound = 0.0;
-  for (int node : nodes) {
+  for (int i = 0; i < static_cast<int>(nodes.size()); ++i) {
+    const int node = nodes[i];
     double s00 = 0, s11 = 0, s22 = 0, s01 = 0, s12 = 0, s20 = 0;
-    for (int e = st.node_offset[node]; e < st.node_offset[node + 1]; ++e) {
-      const int s = st.incident[e];
+    for (int e = st.begin(i, node), e_end = st.end(i, node); e < e_end; ++e) {
+      const int s = st.spring[e];
       const int a = st.a[s], b = st.b[s];
       const double dx = X(b, 0) - X(a, 0), dy = X(b, 1) - X(a, 1), dz = X(b, 2) - X(a, 2);
       const double len2 = dx * dx + dy * dy + dz * dz;
       if (!(len2 > 0.0)) return std::numeric_limits<double>::infinity();
-      const double c = st.stiffness[s] / len2;
+      const double c = st.k[s] / len2;
       s00 += c * dx * dx;
       s11 += c * dy * dy;
       s22 += c * dz * dz;
@@ -942,6 +961,17 @@ Status finishModelAfterCut3D(Model& model, const cutting::TetMesh& after, const 
   auto msSince = [](std::chrono::steady_clock::time_point t) {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
   };
+  // The nodes of the stability estimate (below): near the cut, or all free nodes.
+  // The previous mode near the cut: its estimate is held as a bound for the rest (see
+  // tissue_update3d.hpp), for at most max_held_estimates updates in a row.
+  const bool mode_near_cut = overlap > options.mode_overlap;
+  const int held_before = m.stability_held;
+  const bool can_hold = held_before >= 0 && held_before < options.max_held_estimates;
+  rep.global_stability = !(rep.omega_previous > 0.0) || (mode_near_cut && !can_hold);
+  std::vector<int> estimate_nodes;
+  for (int i = 0; i < N2; ++i)
+    if (!m.fixed[i] && (rep.global_stability || near[i])) estimate_nodes.push_back(i);
+  rep.stability_nodes = static_cast<int>(estimate_nodes.size());
   const auto springs_start = std::chrono::steady_clock::now();
   // Unchanged springs, compacted in place (a row is read before any row at or above it is
   // written), then the recomputed ones: the order of a full copy.
@@ -1001,7 +1031,57 @@ Status finishModelAfterCut3D(Model& model, const cutting::TetMesh& after, const 
     ++out;
     countStep(keep[sp.a], keep[sp.b]);
   }
-  fillStepSprings(m, step_count);
+  // The step's arrays (fillStepSprings), and the springs at the estimate's nodes as the
+  // estimate reads them. With a thread lent, that thread fills the step's arrays while this
+  // one estimates; the estimate then reads the springs (m.springs, which neither thread writes
+  // any more) through lists of its own nodes, built there first: each node's springs in
+  // increasing order, as the step's lists have them, so its sums are the same to the last bit.
+  // (Their sizes are the step degrees counted above; `local` is -1 between calls.)
+  struct EstimateLists {
+    std::vector<std::int32_t> first, cursor, spring, local;
+  };
+  thread_local EstimateLists lists;
+  struct ResetLocal {
+    std::vector<std::int32_t>& local;
+    const std::vector<int>& nodes;
+    bool armed = false;
+    ~ResetLocal() {
+      if (armed)
+        for (int node : nodes) local[node] = -1;
+    }
+  } reset_local{lists.local, estimate_nodes};  // (after the jobs below, which read `local`)
+  NodeSprings node_springs;
+  std::optional<cutting::LentJob> lists_job, fill_job;
+  if (options.beside) {
+    const int count = static_cast<int>(estimate_nodes.size());
+    if (lists.local.size() < static_cast<size_t>(N2)) lists.local.resize(static_cast<size_t>(N2), -1);
+    lists.first.resize(static_cast<size_t>(count) + 1);
+    lists.first[0] = 0;
+    for (int k = 0; k < count; ++k) {
+      lists.local[estimate_nodes[k]] = k;
+      lists.first[k + 1] = lists.first[k] + step_degree[estimate_nodes[k]];
+    }
+    reset_local.armed = true;
+    lists.cursor.assign(lists.first.begin(), lists.first.end() - 1);
+    lists.spring.resize(static_cast<size_t>(lists.first[count]));
+    const std::int32_t* const sa = m.springs.col(0).data();
+    const std::int32_t* const sb = m.springs.col(1).data();
+    const Eigen::Index rows = m.springs.rows();
+    // (The pointers are taken here: `lists` named on the other thread would be its own.)
+    lists_job.emplace(options.beside, [sa, sb, rows, local = lists.local.data(), cursor = lists.cursor.data(),
+                                       spring = lists.spring.data()] {
+      for (Eigen::Index s = 0; s < rows; ++s) {
+        const std::int32_t la = local[sa[s]], lb = local[sb[s]];
+        if (la >= 0) spring[cursor[la]++] = static_cast<std::int32_t>(s);
+        if (lb >= 0) spring[cursor[lb]++] = static_cast<std::int32_t>(s);
+      }
+    });
+    fill_job.emplace(options.beside, [&m, step_count] { fillStepSprings(m, step_count); });
+    node_springs = {lists.first.data(), false, lists.spring.data(), sa, sb, m.stiffness.data()};
+  } else {
+    fillStepSprings(m, step_count);
+    node_springs = NodeSprings::of(m.step_springs);
+  }
   rep.springs_ms = msSince(springs_start);
   cutting::Positions X(N2, 3);
   for (int i = 0; i < N1; ++i)
@@ -1026,16 +1106,6 @@ Status finishModelAfterCut3D(Model& model, const cutting::TetMesh& after, const 
   auto substepsFor = [&](double critical) {
     return std::max(1, static_cast<int>(std::ceil(opt.dt / (opt.stability_safety * critical))));
   };
-  // The previous mode near the cut: its estimate is held as a bound for the rest (see
-  // tissue_update3d.hpp), for at most max_held_estimates updates in a row.
-  const bool mode_near_cut = overlap > options.mode_overlap;
-  const int held_before = m.stability_held;
-  const bool can_hold = held_before >= 0 && held_before < options.max_held_estimates;
-  rep.global_stability = !(rep.omega_previous > 0.0) || (mode_near_cut && !can_hold);
-  std::vector<int> estimate_nodes;
-  for (int i = 0; i < N2; ++i)
-    if (!m.fixed[i] && (rep.global_stability || near[i])) estimate_nodes.push_back(i);
-  rep.stability_nodes = static_cast<int>(estimate_nodes.size());
   bool carried = false;  // omega_max is the previous estimate (scaling near the cut cannot lower it)
   auto carryPrevious = [&]() {
     m.omega_max = rep.omega_previous;
@@ -1059,7 +1129,7 @@ Status finishModelAfterCut3D(Model& model, const cutting::TetMesh& after, const 
     if (!rep.global_stability) {
       // Near the cut, an upper bound below the previous estimate settles what a Lanczos
       // estimate (a lower one) would: the previous estimate is carried over.
-      const double bound = topEigenvalueBound(m, X, estimate_nodes, rep.omega_previous * rep.omega_previous);
+      const double bound = topEigenvalueBound(m, node_springs, X, estimate_nodes, rep.omega_previous * rep.omega_previous);
       if (bound * (1.0 + 1e-9) < rep.omega_previous * rep.omega_previous) {
         rep.omega_local = std::sqrt(bound);
         carryPrevious();
@@ -1069,7 +1139,7 @@ Status finishModelAfterCut3D(Model& model, const cutting::TetMesh& after, const 
     Eigen::MatrixX3d ritz;
     int steps = 0;
     const bool stop_early = options.stop_decided_estimates && may_scale && round_may_follow;
-    const double lambda = topEigenvalue(m, X, estimate_nodes, rep.global_stability ? &mapped_mode : nullptr, options,
+    const double lambda = topEigenvalue(m, node_springs, X, estimate_nodes, rep.global_stability ? &mapped_mode : nullptr, options,
                                         &ritz, &steps, stop_early ? &scaling_follows : nullptr);
     rep.lanczos_steps += steps;
     rep.omega_local = std::sqrt(lambda);
@@ -1087,7 +1157,15 @@ Status finishModelAfterCut3D(Model& model, const cutting::TetMesh& after, const 
     }
   };
   const auto stability_start = std::chrono::steady_clock::now();
+  if (lists_job) lists_job->join();
   estimate(true);
+  double stability_ms = msSince(stability_start);
+  if (fill_job) {  // (the rounds below and the implicit solver read the step's arrays)
+    const auto wait_start = std::chrono::steady_clock::now();
+    fill_job->join();
+    rep.springs_ms += msSince(wait_start);
+  }
+  const auto rounds_start = std::chrono::steady_clock::now();
   // Selective mass scaling, as buildModel, on the nodes of the estimate.
   // A carried-over previous estimate is not lowered by mass near the cut: no rounds then.
   if (opt.substeps <= 0 && opt.max_substeps > 0 && substepsFor(m.critical_dt) > opt.max_substeps && !carried) {
@@ -1108,7 +1186,7 @@ Status finishModelAfterCut3D(Model& model, const cutting::TetMesh& after, const 
       target *= 0.7;
     }
   }
-  rep.stability_ms = msSince(stability_start);
+  rep.stability_ms = stability_ms + msSince(rounds_start);
   m.substeps = opt.substeps > 0 ? opt.substeps : substepsFor(m.critical_dt);
   if (opt.substeps <= 0 && opt.max_substeps > 0) m.substeps = std::min(m.substeps, opt.max_substeps);
   m.substep = opt.dt / m.substeps;

@@ -123,7 +123,9 @@ struct CutUpdate3DOptions {
   // Optional: starts a job on another thread and returns what waits for it (as
   // cutting::Cut3DOptions::beside). The first part hands it the comparison of the elements
   // with the old ones (beside the node -> tets lists) and the springs between touched nodes
-  // (beside the masses); the result is the same to the last bit. Empty: one thread. The
+  // (beside the masses), and the second part the step's spring arrays (filled beside the
+  // stability estimate, which reads lists of its own built there first); the result is the
+  // same to the last bit. Empty: one thread. The
   // jobs must not wait behind the caller (a PassWorker lent from a job on that worker would
   // wait for itself), and one that throws (bad_alloc only) ends the program.
   cutting::Beside beside;
