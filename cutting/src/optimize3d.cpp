@@ -2148,9 +2148,12 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   timed(&OptimizeCounts::collapse_ms, collapseEdges);
   flips();
 
-  // Nodes up to `rings` edge steps from the seeds may move.
+  // Nodes up to `rings` edge steps from the seeds may move (found on region.beside's thread
+  // where given, while this one finds the poor tets around the seeds below: it reads the
+  // tets' nodes and the node -> tets lists, which nothing writes meanwhile, and writes only
+  // `ring`).
   std::vector<std::int8_t> ring(N, -1);
-  {
+  auto findRings = [&] {
     std::vector<std::int32_t> frontier, next;
     for (int n : seeds)
       if (n >= 0 && n < N && ring[n] < 0) {
@@ -2170,7 +2173,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
           }
       frontier.swap(next);
     }
-  }
+  };
   // Work list: the nodes of poor elements around the seeds.
   std::vector<std::int32_t> stamp(N, -1), work;
   auto addBadAround = [&](int n, int round) {
@@ -2186,8 +2189,25 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       }
     }
   };
-  for (int n : seeds)
-    if (n >= 0 && n < N) addBadAround(n, 0);
+  {
+    // (As addBadAround(n, 0) for each seed n: the poor tets met, in order, then their nodes.)
+    std::vector<std::int32_t> poor;
+    {
+      LentJob ringsJob(region.beside, findRings);
+      for (int n : seeds)
+        if (n >= 0 && n < N)
+          for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s)
+            if (!(*dead)[*s] && tetQ(*s) < options.quality_target) poor.push_back(*s);
+    }
+    for (const int t : poor)
+      for (int k = 0; k < 4; ++k) {
+        const int v = mesh.T(t, k);
+        if (ring[v] >= 0 && stamp[v] != 0) {
+          stamp[v] = 0;
+          work.push_back(v);
+        }
+      }
+  }
   std::vector<std::uint8_t> didMove(N, 0);
   std::vector<std::int32_t> movedNow;
   struct StarVolTet {  // per live star tet in the move loop's volume check (see there)
