@@ -2176,17 +2176,20 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   };
   // Work list: the nodes of poor elements around the seeds.
   std::vector<std::int32_t> stamp(N, -1), work;
+  auto addNodesOf = [&](int t, int round) {  // t's nodes within the rings, each once a round
+    for (int k = 0; k < 4; ++k) {
+      const int v = mesh.T(t, k);
+      if (ring[v] >= 0 && stamp[v] != round) {
+        stamp[v] = round;
+        work.push_back(v);
+      }
+    }
+  };
   auto addBadAround = [&](int n, int round) {
     for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s) {
       const int t = (*s);
       if ((*dead)[t] || tetQ(t) >= options.quality_target) continue;
-      for (int k = 0; k < 4; ++k) {
-        const int v = mesh.T(t, k);
-        if (ring[v] >= 0 && stamp[v] != round) {
-          stamp[v] = round;
-          work.push_back(v);
-        }
-      }
+      addNodesOf(t, round);
     }
   };
   {
@@ -2199,14 +2202,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
           for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s)
             if (!(*dead)[*s] && tetQ(*s) < options.quality_target) poor.push_back(*s);
     }
-    for (const int t : poor)
-      for (int k = 0; k < 4; ++k) {
-        const int v = mesh.T(t, k);
-        if (ring[v] >= 0 && stamp[v] != 0) {
-          stamp[v] = 0;
-          work.push_back(v);
-        }
-      }
+    for (const int t : poor) addNodesOf(t, 0);
   }
   std::vector<std::uint8_t> didMove(N, 0);
   std::vector<std::int32_t> movedNow;
