@@ -247,6 +247,18 @@ void lanczosNext(Eigen::Index n, const double* z, double b, double* q, double* c
   (avx2 ? nextAvx2 : nextBaseline)(n, z, b, q, column);
 }
 
+// Resets a table of local numbers (-1 between uses) at `nodes` when it goes out of scope,
+// once armed.
+struct ResetLocal {
+  std::vector<int>& local;
+  const std::vector<int>& nodes;
+  bool armed = true;
+  ~ResetLocal() {
+    if (armed)
+      for (int node : nodes) local[node] = -1;
+  }
+};
+
 // The springs at each estimate node, in increasing spring order (the order StepSprings lists
 // them in, so that the sums over them are the same to the last bit): those of nodes[k] are
 // spring[e] for first[i] <= e < first[i + 1], with i = nodes[k] (StepSprings' own lists) or
@@ -292,13 +304,7 @@ double topEigenvalue(const Model& m, const NodeSprings& st, const cutting::Posit
   std::vector<int>& local = scratch.local;
   if (local.size() < static_cast<size_t>(m.num_nodes)) local.resize(static_cast<size_t>(m.num_nodes), -1);
   for (int k = 0; k < count; ++k) local[nodes[k]] = k;
-  struct ResetLocal {
-    std::vector<int>& local;
-    const std::vector<int>& nodes;
-    ~ResetLocal() {
-      for (int node : nodes) local[node] = -1;
-    }
-  } reset_local{local, nodes};
+  ResetLocal reset_local{local, nodes};
   // The operator (see SpringY): with y = M^-1/2 u, a spring between free nodes contributes
   // t = k d.(y_b - y_a) to z_b along d and its negative to z_a; with w = sqrt(k) d that is
   // t = w.(y_b - y_a), z_a -= t w, z_b += t w. A spring to a held node (y = 0 there) only adds
@@ -1041,15 +1047,7 @@ Status finishModelAfterCut3D(Model& model, const cutting::TetMesh& after, const 
     std::vector<std::int32_t> first, cursor, spring, local;
   };
   thread_local EstimateLists lists;
-  struct ResetLocal {
-    std::vector<std::int32_t>& local;
-    const std::vector<int>& nodes;
-    bool armed = false;
-    ~ResetLocal() {
-      if (armed)
-        for (int node : nodes) local[node] = -1;
-    }
-  } reset_local{lists.local, estimate_nodes};  // (after the jobs below, which read `local`)
+  ResetLocal reset_local{lists.local, estimate_nodes, false};  // (after the jobs below, which read `local`)
   NodeSprings node_springs;
   std::optional<cutting::LentJob> lists_job, fill_job;
   if (options.beside) {
