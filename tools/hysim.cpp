@@ -55,6 +55,7 @@ struct RunArgs {
   std::string frames;
   std::string report;
   std::string chips;  // empty: the scene's
+  std::string mesh;   // empty: the scene's
   bool quiet = false;
   std::string dump_cuts;  // folder for each pass's cut input (debugging)
 };
@@ -65,6 +66,7 @@ int runCommand(const RunArgs& args) {
   if (!scene.ok()) return fail(scene.error());
   if (args.chips == "remove") scene->chips.mode = engine::ChipSettings::Mode::Remove;
   if (args.chips == "simulate") scene->chips.mode = engine::ChipSettings::Mode::Simulate;
+  if (!args.mesh.empty()) scene->mesh_path = args.mesh;
   auto sim = engine::Simulation::create(*scene);
   if (!sim.ok()) return fail(sim.error());
   if (!args.dump_cuts.empty()) {
@@ -156,6 +158,10 @@ int main(int argc, char** argv) {
   run_cmd->add_option("--report", run.report, "Write the JSON report to this file");
   run_cmd->add_option("--chips", run.chips, "Override the scene's chips mode: remove or simulate")
       ->check(CLI::IsMember({"remove", "simulate"}));
+  run_cmd->add_option("--mesh", run.mesh,
+                      "Override the scene's tissue mesh: a tet mesh (.msh or .vtk) of the same organ with the scene's "
+                      "material labels, e.g. a finer one (tests/data/cutting/uterus_20k.msh)")
+      ->check(CLI::ExistingFile);
   run_cmd->add_flag("--quiet", run.quiet, "Print nothing but errors");
   run_cmd->add_option("--dump-cuts", run.dump_cuts,
                       "Debugging: write each pass's cut input into this folder (pass_NNN_mesh.msh, the rest mesh "

@@ -134,6 +134,30 @@ TEST(Cli, BadSceneFailsAndKeepsTheOldReport) {
   EXPECT_TRUE(nlohmann::json::parse(in)["kept"].get<bool>());
 }
 
+TEST(Cli, RunTakesAnotherMeshOfTheOrgan) {
+  const std::string dir = outDir("mesh");
+  const Output o = hysim("run --steps 5 --quiet --mesh tests/data/cutting/uterus_20k.msh --report " + dir + "/report.json");
+  ASSERT_EQ(o.exit_code, 0) << o.text;
+  std::ifstream in(dir + "/report.json");
+  const auto j = nlohmann::json::parse(in);
+  EXPECT_EQ(j["elements"].get<int>(), 20971);  // the scene's own mesh has 12,139
+  EXPECT_EQ(j["steps"].get<int>(), 5);
+}
+
+TEST(Cli, RunRefusesAMissingOrWrongMesh) {
+  const std::string dir = outDir("badmesh");
+  std::ofstream(dir + "/report.json") << "{\"kept\": true}\n";
+  Output o = hysim("run --steps 5 --mesh /nonexistent/organ.msh --report " + dir + "/report.json");
+  EXPECT_NE(o.exit_code, 0);
+  EXPECT_NE(o.text.find("/nonexistent/organ.msh"), std::string::npos) << o.text;
+  // A surface, not a tet mesh.
+  o = hysim("run --steps 5 --mesh assets/resectoscope.stl --report " + dir + "/report.json");
+  EXPECT_NE(o.exit_code, 0);
+  EXPECT_NE(o.text.find("resectoscope.stl"), std::string::npos) << o.text;
+  std::ifstream in(dir + "/report.json");
+  EXPECT_TRUE(nlohmann::json::parse(in)["kept"].get<bool>());
+}
+
 TEST(Cli, SameSceneTwiceSameHash) {
   const std::string dir = outDir("hash");
   ASSERT_EQ(hysim("run --steps 100 --quiet --report " + dir + "/a.json").exit_code, 0);
