@@ -58,6 +58,8 @@ struct RunArgs {
   std::string mesh;   // empty: the scene's
   bool quiet = false;
   std::string dump_cuts;  // folder for each pass's cut input (debugging)
+  bool realtime = false;  // pace to the wall clock with the haptic thread
+  bool sync_cut = false;  // cut on the simulation thread (reference mode)
 };
 
 int runCommand(const RunArgs& args) {
@@ -67,6 +69,7 @@ int runCommand(const RunArgs& args) {
   if (args.chips == "remove") scene->chips.mode = engine::ChipSettings::Mode::Remove;
   if (args.chips == "simulate") scene->chips.mode = engine::ChipSettings::Mode::Simulate;
   if (!args.mesh.empty()) scene->mesh_path = args.mesh;
+  if (args.sync_cut) scene->cut.mode = engine::CutSettings::Mode::Sync;
   auto sim = engine::Simulation::create(*scene);
   if (!sim.ok()) return fail(sim.error());
   if (!args.dump_cuts.empty()) {
@@ -80,6 +83,7 @@ int runCommand(const RunArgs& args) {
   engine::RunOptions options;
   options.steps = args.steps;
   options.every = args.every;
+  options.realtime = args.realtime;
   if (!args.frames.empty()) {
     std::error_code ec;
     fs::create_directories(args.frames, ec);
@@ -111,6 +115,17 @@ int runCommand(const RunArgs& args) {
                 report->steps, report->wall_s, report->step_us_median, report->step_us_p99, report->frames,
                 report->frame_ms_median, engine::hashHex(report->state_hash).c_str(), report->warnings);
     if (!report->passes.empty()) std::printf("last pass: q*_min %.4f\n", report->passes.back().q_min);
+    std::printf("cuts (%s, commit after %d steps): latency median %.1f ms, p99 %.1f, max %.1f; commit step "
+                "median %.0f us, max %.0f; stalls %d; step max %.1f us\n",
+                report->cut_mode.c_str(), report->commit_steps, report->cut_latency_ms.median,
+                report->cut_latency_ms.p99, report->cut_latency_ms.max, report->commit_us.median,
+                report->commit_us.max, report->stalls, report->step_us_max);
+    if (report->realtime) {
+      std::printf("haptic thread: %ld ticks, period p50 %.1f us, p99 %.1f, max %.1f; %ld overruns; %s\n",
+                  report->haptic_ticks, report->haptic_period_us.median, report->haptic_period_us.p99,
+                  report->haptic_period_us.max, report->haptic_overruns,
+                  report->haptic_realtime_priority ? "real-time priority" : "normal priority");
+    }
     std::printf("%s", engine::summaryText(*report).c_str());
     if (!args.frames.empty()) std::printf("frames in %s\n", args.frames.c_str());
     if (!args.report.empty()) std::printf("report in %s\n", args.report.c_str());
@@ -163,6 +178,12 @@ int main(int argc, char** argv) {
                       "material labels, e.g. a finer one (tests/data/cutting/uterus_20k.msh)")
       ->check(CLI::ExistingFile);
   run_cmd->add_flag("--quiet", run.quiet, "Print nothing but errors");
+  run_cmd->add_flag("--realtime", run.realtime,
+                    "Pace the steps to the wall clock, with the haptic thread (1 kHz) rendering forces on a simulated "
+                    "device; the state sequence is the same as without");
+  run_cmd->add_flag("--sync-cut", run.sync_cut,
+                    "Reference mode: cut on the simulation thread at the pass's exit step (committed at the same "
+                    "step as the worker's cut; the same state_hash)");
   run_cmd->add_option("--dump-cuts", run.dump_cuts,
                       "Debugging: write each pass's cut input into this folder (pass_NNN_mesh.msh, the rest mesh "
                       "before the cut; pass_NNN_surface.msh, the cut surface; full precision). "

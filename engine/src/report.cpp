@@ -7,7 +7,6 @@
 #include "hysim/engine/run.hpp"
 
 namespace hysim::engine {
-namespace {
 
 double percentile(std::vector<double> values, double p) {
   if (values.empty()) return 0.0;
@@ -16,78 +15,10 @@ double percentile(std::vector<double> values, double p) {
   return values[k];
 }
 
-}  // namespace
-
 std::string hashHex(std::uint64_t hash) {
   char buf[17];
   std::snprintf(buf, sizeof(buf), "%016llx", static_cast<unsigned long long>(hash));
   return buf;
-}
-
-Result<RunReport> run(Simulation& sim, const RunOptions& options) {
-  using Clock = std::chrono::steady_clock;
-  const Scene& scene = sim.scene();
-  RunReport r;
-  r.scene = scene.name;
-  r.steps = options.steps >= 0 ? options.steps : scene.steps;
-  const int every = options.every > 0 ? options.every : scene.render.every;
-  r.dt = scene.sim.dt;
-  r.nodes = sim.mesh().numNodes();
-  r.elements = sim.mesh().numTets();
-  r.deformable_elements = sim.numDeformableTets();
-  r.springs = static_cast<int>(sim.model().springs.rows());
-  r.anchored = sim.numAnchored();
-  r.substeps = sim.model().substeps;
-  r.critical_dt = sim.model().critical_dt;
-  r.integrator = scene.sim.integrator == sim::Integrator::ImplicitEuler ? "implicit_euler" : "symplectic_euler";
-
-  std::vector<double> step_us;
-  step_us.reserve(static_cast<size_t>(r.steps));
-  std::vector<double> frame_ms;
-  render::RenderSnapshot snapshot;
-  const auto wall0 = Clock::now();
-  auto frame = [&]() -> Status {
-    if (!options.on_frame) return Status::Ok();
-    const auto t0 = Clock::now();
-    sim.fillSnapshot(snapshot);
-    Status st = options.on_frame(snapshot, r.frames);
-    frame_ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
-    ++r.frames;
-    return st;
-  };
-  if (Status st = frame(); !st.ok()) return Error{st.error()};
-  for (int i = 0; i < r.steps; ++i) {
-    const auto t0 = Clock::now();
-    sim.step();
-    step_us.push_back(std::chrono::duration<double, std::micro>(Clock::now() - t0).count());
-    r.max_tool_force_n = std::max(r.max_tool_force_n, sim.toolForceN().norm());
-    if ((i + 1) % every == 0) {
-      if (Status st = frame(); !st.ok()) return Error{st.error()};
-    }
-  }
-  r.wall_s = std::chrono::duration<double>(Clock::now() - wall0).count();
-  r.step_us_median = percentile(step_us, 0.5);
-  r.step_us_p99 = percentile(step_us, 0.99);
-  r.step_us_max = step_us.empty() ? 0.0 : *std::max_element(step_us.begin(), step_us.end());
-  r.frame_ms_median = percentile(frame_ms, 0.5);
-  r.state_hash = sim.stateHash();
-  r.warnings = sim.state().warnings;
-  r.passes = sim.passes();
-  r.initial_myoma_mm3 = sim.initialMyomaVolume();
-  r.electrode_active_s = sim.electrodeActiveSeconds();
-  r.path_length_mm = sim.pathLengthMm();
-  r.perforation_margin_mm = scene.safety.perforation_margin_mm;
-  r.perforations = sim.perforations();
-  r.perforation_events = sim.perforationEvents();
-  r.serosa_faces = sim.outerWall().numFaces();
-  if (const ChipWorld* chips = sim.chips(); chips != nullptr) {
-    r.chips_mode = "simulate";
-    r.chips_in_cavity = chips->numChips();
-    r.chips_left_cavity = chips->removedOutside();
-    r.chips_over_cap = chips->removedOverCap();
-    r.chip_step_us_mean = sim.chipSteps() > 0 ? 1e6 * sim.chipStepSeconds() / static_cast<double>(sim.chipSteps()) : 0.0;
-  }
-  return r;
 }
 
 RunSummary summarize(const RunReport& r) {
@@ -139,6 +70,22 @@ std::string reportJson(const RunReport& r) {
   j["substeps"] = r.substeps;
   j["critical_dt"] = r.critical_dt;
   j["step_us"] = {{"median", r.step_us_median}, {"p99", r.step_us_p99}, {"max", r.step_us_max}};
+  auto spread = [](const Spread& s) { return nlohmann::ordered_json{{"median", s.median}, {"p99", s.p99}, {"max", s.max}}; };
+  j["realtime"] = r.realtime;
+  j["cut_mode"] = r.cut_mode;
+  j["commit_steps"] = r.commit_steps;
+  j["stalls"] = r.stalls;
+  j["stall_ms"] = r.stall_ms;
+  j["commit_us"] = spread(r.commit_us);
+  j["cut_latency_ms"] = spread(r.cut_latency_ms);
+  if (r.realtime) {
+    j["haptic_period_us"] = {{"p50", r.haptic_period_us.median}, {"p99", r.haptic_period_us.p99},
+                             {"max", r.haptic_period_us.max}};
+    j["haptic_ticks"] = r.haptic_ticks;
+    j["haptic_overruns"] = r.haptic_overruns;
+    j["haptic_realtime_priority"] = r.haptic_realtime_priority;
+    j["step_start_late_us"] = spread(r.step_start_late_us);
+  }
   j["frames"] = r.frames;
   j["frame_ms"] = {{"median", r.frame_ms_median}};
   j["state_hash"] = hashHex(r.state_hash);
@@ -153,11 +100,15 @@ std::string reportJson(const RunReport& r) {
     e["nodes"] = p.nodes;
     e["q_min"] = p.q_min;
     e["cut_ms"] = p.cut_ms;
-    e["cut_parts_ms"] = {{"map", p.map_ms},           {"cut3d", p.cut3d_ms},       {"remap", p.remap_ms},
-                         {"components", p.components_ms}, {"model", p.model_ms},   {"surface", p.surface_ms},
-                         {"collision", p.collision_ms}, {"locator", p.locator_ms}, {"chips", p.chips_ms},
-                         {"stats", p.stats_ms},         {"other", p.other_ms},
-                         {"geometry_wait", p.geometry_wait_ms}};
+    e["cut_parts_ms"] = {{"cut3d", p.cut3d_ms},         {"components", p.components_ms}, {"model", p.model_ms},
+                         {"surface", p.surface_ms},     {"collision", p.collision_ms},   {"locator", p.locator_ms},
+                         {"chips", p.chips_ms},         {"stats", p.stats_ms},           {"other", p.other_ms}};
+    e["exit_step"] = p.exit_step;
+    e["commit_step"] = p.commit_step;
+    e["map_ms"] = p.map_ms;
+    e["commit_us"] = p.commit_us;
+    e["stall_ms"] = p.stall_ms;
+    e["latency_ms"] = p.latency_ms;
     e["chips"] = p.chips;
     e["removed_mm3"] = p.removed_mm3;
     e["removed_myoma_mm3"] = p.removed_myoma_mm3;

@@ -234,12 +234,23 @@ haptics::Keyframe parseKeyframe(const Reader& r, const YAML::Node& n, const hapt
   return k;
 }
 
+void parseCut(const Reader& r, const YAML::Node& n, CutSettings& c) {
+  r.checkKeys(n, "cut", {"mode", "commit_steps"});
+  if (n["mode"]) {
+    const std::string s = r.string(n["mode"], "mode");
+    if (s == "async") c.mode = CutSettings::Mode::Async;
+    else if (s == "sync") c.mode = CutSettings::Mode::Sync;
+    else r.fail(n["mode"], "'cut.mode' must be async or sync, got '" + s + "'");
+  }
+  if (n["commit_steps"]) c.commit_steps = r.integer(n["commit_steps"], "commit_steps", 0, 1000);
+}
+
 Scene parse(const Reader& r, const YAML::Node& root, const std::string& path) {
   Scene scene;
   scene.path = path;
   if (!root.IsDefined() || root.IsNull()) r.fail(root, "the scene file is empty");
   r.checkKeys(root, "scene", {"name", "description", "mesh", "tool_mesh", "materials", "anchors", "simulation",
-                              "contact", "safety", "tool_path", "camera", "render", "chips"});
+                              "contact", "safety", "tool_path", "camera", "render", "chips", "cut"});
   const fs::path dir = fs::path(path).parent_path();
   auto resolve = [&](const YAML::Node& n, const std::string& key) {
     const std::string rel = r.string(n, key);
@@ -280,6 +291,7 @@ Scene parse(const Reader& r, const YAML::Node& root, const std::string& path) {
     }
   }
   if (root["chips"]) parseChips(r, root["chips"], scene.chips);
+  if (root["cut"]) parseCut(r, root["cut"], scene.cut);
 
   const YAML::Node tp = r.require(root, "tool_path", "scene");
   if (!tp.IsSequence() || tp.size() == 0) r.fail(tp, "'tool_path' must be a non-empty list of keyframes");

@@ -8,6 +8,7 @@
 
 #include "alloc_counter.hpp"
 #include "box_mesh.hpp"
+#include "slab_scenes.hpp"
 #include "test_dir.hpp"
 #include "hysim/cutting/cut3d.hpp"
 #include "hysim/cutting/mesh_io.hpp"
@@ -23,30 +24,7 @@ namespace fs = std::filesystem;
 // The running test's own folder (test_dir.hpp).
 fs::path testDir() { return testing::testDir("shaving"); }
 
-// Slab 30 x 20 x 10 mm, top face at z = 0, anchored at the bottom. The scope points along
-// +x with up = +z, so the loop (radius 3.5, centre 3 mm below the axis) hangs down; its
-// lowest point is 2 mm below the slab's top.
-std::string writeSlabScene(bool pedal) {
-  const fs::path dir = testDir();
-  cutting::TetMesh slab = testing::boxTetMesh(15, 10, 5, 2.0);
-  for (int i = 0; i < slab.numNodes(); ++i) slab.X.row(i) -= Eigen::RowVector3d(15, 10, 10);
-  EXPECT_TRUE(cutting::writeMesh((dir / "slab.msh").string(), slab).ok());
-  const std::string p = pedal ? "true" : "false";
-  std::ofstream(dir / (pedal ? "slab_cut.yaml" : "slab_nocut.yaml"))
-      << "name: slab\n"
-         "mesh: slab.msh\n"
-         "materials:\n"
-         "  - {name: myoma, label: 1, young_modulus_kpa: 150, density_g_cm3: 1.1}\n"
-         "anchors:\n"
-         "  - box: {min: [-20, -20, -11], max: [20, 20, -9.5]}\n"
-         "simulation: {dt_ms: 1.0, steps: 1300, drag_per_s: 30, gravity_mm_s2: [0, 0, 0]}\n"
-         "tool_path:\n"
-         "  - {t_s: 0.0, tip: [8, 0, 4.5], axis: [1, 0, 0], up: [0, 0, 1]}\n"
-         "  - {t_s: 0.05, tip: [8, 0, 4.5], axis: [1, 0, 0], up: [0, 0, 1], pedal: " << p << "}\n"
-         "  - {t_s: 1.05, tip: [-32, 0, 4.5], axis: [1, 0, 0], up: [0, 0, 1], pedal: " << p << "}\n"
-         "  - {t_s: 1.10, tip: [-32, 0, 4.5], axis: [1, 0, 0], up: [0, 0, 1]}\n";
-  return (dir / (pedal ? "slab_cut.yaml" : "slab_nocut.yaml")).string();
-}
+std::string writeSlabScene(bool pedal) { return testing::writeSlabScene(testDir(), pedal); }
 
 TEST(Shaving, OnePassThroughASlabCutsOnExit) {
   auto scene = loadScene(writeSlabScene(true));
@@ -194,36 +172,7 @@ TEST(Shaving, SamePassTwiceGivesTheSameState) {
 // of the first, so their sweeps cross the first pass's cut surface, as shaving does): after
 // every pass the mesh is valid (no inverted or flat tet, manifold, no duplicate faces).
 TEST(Shaving, OverlappingPassesKeepTheMeshValid) {
-  const fs::path dir = testDir();
-  cutting::TetMesh slab = testing::boxTetMesh(15, 10, 5, 2.0);
-  for (int i = 0; i < slab.numNodes(); ++i) slab.X.row(i) -= Eigen::RowVector3d(15, 10, 10);
-  ASSERT_TRUE(cutting::writeMesh((dir / "slab.msh").string(), slab).ok());
-  std::ofstream(dir / "slab_passes.yaml")
-      << "name: slab\n"
-         "mesh: slab.msh\n"
-         "materials:\n"
-         "  - {name: myoma, label: 1, young_modulus_kpa: 150, density_g_cm3: 1.1}\n"
-         "anchors:\n"
-         "  - box: {min: [-20, -20, -11], max: [20, 20, -9.5]}\n"
-         "simulation: {dt_ms: 1.0, steps: 5200, drag_per_s: 30, gravity_mm_s2: [0, 0, 0]}\n"
-         "tool_path:\n"
-         "  - {t_s: 0.0, tip: [8, 0, 4.5], axis: [1, 0, 0], up: [0, 0, 1]}\n"
-         "  - {t_s: 0.05, tip: [8, 0, 4.5], axis: [1, 0, 0], up: [0, 0, 1], pedal: true}\n"
-         "  - {t_s: 1.05, tip: [-32, 0, 4.5], axis: [1, 0, 0], up: [0, 0, 1], pedal: true}\n"
-         "  - {t_s: 1.10, tip: [-32, 0, 4.5], axis: [1, 0, 0], up: [0, 0, 1]}\n"
-         "  - {t_s: 1.30, tip: [-32, 0, 14], axis: [1, 0, 0], up: [0, 0, 1]}\n"
-         "  - {t_s: 1.80, tip: [8, 2, 14], axis: [1, 0, 0], up: [0, 0, 1]}\n"
-         "  - {t_s: 2.00, tip: [8, 2, 4.0], axis: [1, 0, 0], up: [0, 0, 1]}\n"
-         "  - {t_s: 2.05, tip: [8, 2, 4.0], axis: [1, 0, 0], up: [0, 0, 1], pedal: true}\n"
-         "  - {t_s: 3.05, tip: [-32, 2, 4.0], axis: [1, 0, 0], up: [0, 0, 1], pedal: true}\n"
-         "  - {t_s: 3.10, tip: [-32, 2, 4.0], axis: [1, 0, 0], up: [0, 0, 1]}\n"
-         "  - {t_s: 3.30, tip: [-32, 2, 14], axis: [1, 0, 0], up: [0, 0, 1]}\n"
-         "  - {t_s: 3.80, tip: [8, -2, 14], axis: [1, 0, 0], up: [0, 0, 1]}\n"
-         "  - {t_s: 4.00, tip: [8, -2, 3.7], axis: [1, 0, 0], up: [0, 0, 1]}\n"
-         "  - {t_s: 4.05, tip: [8, -2, 3.7], axis: [1, 0, 0], up: [0, 0, 1], pedal: true}\n"
-         "  - {t_s: 5.05, tip: [-32, -2, 3.7], axis: [1, 0, 0], up: [0, 0, 1], pedal: true}\n"
-         "  - {t_s: 5.10, tip: [-32, -2, 3.7], axis: [1, 0, 0], up: [0, 0, 1]}\n";
-  auto scene = loadScene((dir / "slab_passes.yaml").string());
+  auto scene = loadScene(testing::writeThreePassSlabScene(testDir()));
   ASSERT_TRUE(scene.ok()) << scene.error();
   auto sim = Simulation::create(*scene);
   ASSERT_TRUE(sim.ok()) << sim.error();

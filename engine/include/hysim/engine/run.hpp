@@ -1,6 +1,8 @@
 #pragma once
 // The fixed-step loop: steps a Simulation for a number of steps, hands a snapshot to a
-// frame callback every k steps, and measures. Real-time pacing is the app's job, not this.
+// frame callback every k steps, and measures. As fast as possible, or (realtime) paced to
+// the wall clock with the haptic thread rendering the published local force model on a
+// simulated device; the state sequence is the same either way.
 #include <cstdint>
 #include <functional>
 #include <string>
@@ -15,7 +17,17 @@ struct RunOptions {
   int every = -1;  // -1: the scene's render.every
   // Called with the snapshot every `every` steps (and at step 0); an error stops the run.
   std::function<Status(const render::RenderSnapshot&, int frame_index)> on_frame;
+  // Pace each step to start dt after the previous one on the wall clock (absolute sleeps),
+  // with a HapticLoop at 1 kHz driving a simulated device (the scene's script).
+  bool realtime = false;
 };
+
+// Median, 99th percentile and maximum of a set of samples (0 when empty).
+struct Spread {
+  double median = 0.0, p99 = 0.0, max = 0.0;
+};
+Spread spreadOf(const std::vector<double>& values);
+double percentile(std::vector<double> values, double p);
 
 struct RunReport {
   std::string scene;
@@ -26,6 +38,20 @@ struct RunReport {
   int substeps = 1;
   double critical_dt = 0.0;    // s
   double step_us_median = 0.0, step_us_p99 = 0.0, step_us_max = 0.0;
+  // The cut worker: commit steps that waited for it (and the whole wait), the commit
+  // step's own work, the wall time from a pass's exit step to its commit step.
+  int stalls = 0;
+  double stall_ms = 0.0;
+  Spread commit_us, cut_latency_ms;
+  int commit_steps = 0;        // the scene's K
+  std::string cut_mode;        // async or sync
+  bool realtime = false;
+  // Realtime runs: the haptic thread's periods between tick starts, its overruns (> 1.5x
+  // the period), whether it got real-time priority, and how late steps started (us).
+  Spread haptic_period_us;
+  long haptic_ticks = 0, haptic_overruns = 0;
+  bool haptic_realtime_priority = false;
+  Spread step_start_late_us;
   int frames = 0;
   double frame_ms_median = 0.0;  // time spent in the frame callback (render + PNG)
   std::uint64_t state_hash = 0;

@@ -66,6 +66,17 @@ struct ChipSettings {
   bool optimize = false;
 };
 
+// When a shaving pass's cut reaches the simulation: the cut runs on the cut worker from the
+// step the loop leaves the tissue, and its result replaces the tissue K steps later
+// (commit_steps), whatever the worker's timing (a late worker makes that step wait: a stall).
+// Sync runs the same job on the simulation thread at the exit step (a reference: the same
+// state sequence, to the last bit).
+struct CutSettings {
+  enum class Mode { Async, Sync };
+  Mode mode = Mode::Async;
+  int commit_steps = 20;
+};
+
 struct Scene {
   std::string path;        // the scene file
   std::string name;
@@ -82,6 +93,7 @@ struct Scene {
   CameraSettings camera;
   RenderSettings render;
   ChipSettings chips;
+  CutSettings cut;
 };
 
 // Parses and checks a scene file. Does not load the meshes (see Simulation::create).

@@ -1,68 +1,29 @@
 #pragma once
 // The fixed-step loop's state: tissue model, tool, contact. One call of step() advances the
 // whole simulation by the scene's dt; it never reads the wall clock and never allocates.
+#include <chrono>
 #include <functional>
 #include <memory>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include "hysim/cutting/mesh.hpp"
-#include "hysim/engine/collision.hpp"
-#include "hysim/engine/outer_wall.hpp"
 #include "hysim/engine/chips.hpp"
+#include "hysim/engine/collision.hpp"
+#include "hysim/engine/cut_job.hpp"
+#include "hysim/engine/cut_worker.hpp"
 #include "hysim/engine/mesh_faces.hpp"
+#include "hysim/engine/outer_wall.hpp"
+#include "hysim/engine/pass_record.hpp"
 #include "hysim/engine/scene.hpp"
 #include "hysim/engine/tet_locator.hpp"
+#include "hysim/engine/tissue.hpp"
 #include "hysim/engine/tool.hpp"
 #include "hysim/haptics/device.hpp"
 #include "hysim/render/snapshot.hpp"
 #include "hysim/sim/model.hpp"
 
 namespace hysim::engine {
-
-// One shaving pass: the loop entered the tissue with the pedal down and left it (or the
-// pedal was released); the accumulated sweep was cut with the hybrid method.
-struct PassRecord {
-  double time_s = 0.0;
-  int elements = 0;          // after the pass (chips removed)
-  int nodes = 0;
-  double q_min = 0.0;        // q* = r_in / R_circ of the worst tet after the pass
-  double cut_ms = 0.0;       // cut + chip removal + model rebuild (the whole pass, wall time)
-  // cut_ms split into its parts (wall time, ms): carrying the sweep to the rest shape,
-  // cutting::cut3d, current positions of the cut mesh, free pieces found and removed (mesh
-  // compacted), the tissue model (masses, springs, stability), boundary/render/contact
-  // arrays, the FCL hierarchy, the tet locator, chip shapes and bodies, mesh statistics;
-  // other_ms is what is left (cut_ms minus the parts). The model update's first part (masses
-  // and springs around the cut) runs on a second thread from the end of cut3d, beside the
-  // remap and the piece search; model_ms counts the wait for it and the second part. The
-  // boundary and FCL hierarchy (surface_ms, collision_ms: that thread's wall time) are then
-  // built on the same thread while this one updates the model (model_ms) and computes the
-  // mesh statistics (stats_ms); geometry_wait_ms is how long this thread then waited for them
-  // (what they add to cut_ms), and other_ms is computed with geometry_wait_ms in place of
-  // those two. The tet locator (locator_ms) is built on a
-  // background thread after the pass has ended, beside the following steps, and is not part
-  // of cut_ms (at the start of a run, setTopology builds it in place); the same thread finds
-  // the new mesh's distances to the anchors (for the next pass's piece search) and, when the
-  // pass searched for free pieces near its cut only, counts `components`: locator_ms includes
-  // both.
-  double map_ms = 0.0, cut3d_ms = 0.0, remap_ms = 0.0, components_ms = 0.0, model_ms = 0.0, surface_ms = 0.0,
-         collision_ms = 0.0, locator_ms = 0.0, chips_ms = 0.0, stats_ms = 0.0, other_ms = 0.0,
-         geometry_wait_ms = 0.0;
-  int chips = 0;             // free pieces removed
-  double removed_mm3 = 0.0;  // volume of the removed chips
-  double removed_myoma_mm3 = 0.0;
-  double sweep_area_mm2 = 0.0;  // area of the cut surface (the loop's sweep)
-  int crossed_edges = 0, snapped_nodes = 0, split_edges = 0, duplicated_nodes = 0, cut_faces = 0;
-  int unoptimised_chip_elements = 0;  // chips.optimize false: the tets the cut left as cut
-  int components = 0;        // pieces of the cut mesh (chips included); passes() waits for it
-  int substeps = 0;          // of the rebuilt model
-  double added_mass_g = 0.0; // mass scaling needed to keep substeps within the cap (since the start)
-  int stability_nodes = 0;   // free nodes of the model update's frequency estimate
-  bool global_stability = false;  // that estimate covered the whole mesh (the highest mode was near the cut)
-  bool cut_failed = false;   // the cut was refused (the mesh is left as it was)
-  std::string message;
-};
 
 // One perforation event: while the electrode was active, the loop's wire came closer than
 // the scene's safety.perforation_margin_mm to the outer (serosal) surface, or went beyond it.
@@ -72,17 +33,16 @@ struct PerforationEvent {
   double min_distance_mm = 0.0;  // closest approach of the wire's surface; < 0: beyond the serosa
 };
 
-class PassWorker;  // pass_worker.hpp
-
 class Simulation {
  public:
   // Loads the meshes named by the scene, anchors nodes, builds the tissue model.
   static Result<std::unique_ptr<Simulation>> create(const Scene& scene);
-  ~Simulation();  // waits for a locator build still running
+  ~Simulation();  // waits for a cut still on the worker
 
-  // Advances one fixed step. Allocates nothing, also while the loop cuts through tissue,
-  // except on the step a shaving pass ends (the loop leaves the tissue), when the cut
-  // changes the topology.
+  // Advances one fixed step. Allocates nothing, also while the loop cuts through tissue and
+  // on the step that commits a cut (it swaps in what the cut worker prepared), except on the
+  // step a shaving pass ends (the loop leaves the tissue), which hands the cut to the worker,
+  // and, with simulated chips, the commit step (chips enter the rigid-body world).
   void step();
 
   // Fills a snapshot for the renderer. Reuses the snapshot's buffers (no allocation after
@@ -90,18 +50,22 @@ class Simulation {
   void fillSnapshot(render::RenderSnapshot& snapshot) const;
 
   const Scene& scene() const { return scene_; }
-  const cutting::TetMesh& mesh() const { return mesh_; }
-  const sim::Model& model() const { return model_; }
+  const cutting::TetMesh& mesh() const { return tissue_->mesh; }
+  const sim::Model& model() const { return tissue_->model; }
   const sim::State& state() const { return state_; }
   const haptics::ToolPose& toolPose() const { return pose_; }
   const haptics::Device& device() const { return *device_; }
   // Replaces the device that drives the tool (e.g. a keyboard device in the trainee app).
   void setDevice(std::unique_ptr<haptics::Device> device) { device_ = std::move(device); }
-  int numAnchored() const { return num_anchored_; }
-  int numDeformableTets() const { return num_deformable_tets_; }  // tets with at least one free node
-  int numSurfaceNodes() const { return static_cast<int>(surface_nodes_.size()); }
+  int numAnchored() const { return tissue_->num_anchored; }
+  int numDeformableTets() const { return tissue_->num_deformable_tets; }  // tets with at least one free node
+  int numSurfaceNodes() const { return static_cast<int>(tissue_->surface_nodes.size()); }
   // Reaction force on the tool from tissue contact in the last step, newtons.
   const Eigen::Vector3d& toolForceN() const { return tool_force_n_; }
+  // How that force changes with the tool's position (N/mm, symmetric, negative
+  // semi-definite: pushing further in pushes back harder): the local model the haptic
+  // thread renders between steps.
+  const Eigen::Matrix3d& toolStiffnessNPerMm() const { return tool_stiffness_; }
   // Positions and velocities of the tissue, and the simulated chips' poses (when there are any).
   std::uint64_t stateHash() const { return chips_ ? chips_->hash(sim::stateHash(state_)) : sim::stateHash(state_); }
   // The simulated chips (scene `chips: simulate`); null when chips are removed.
@@ -109,14 +73,20 @@ class Simulation {
   // Wall time spent stepping the chips (Bullet), seconds, and the steps that had chips.
   double chipStepSeconds() const { return chip_step_s_; }
   long chipSteps() const { return chip_steps_; }
-  const std::vector<PassRecord>& passes() const {
-    waitLocator();  // the last pass's locator_ms
-    return passes_;
-  }
+  // Committed passes, in order (a pass whose cut is still on the worker is not yet here).
+  const std::vector<PassRecord>& passes() const { return passes_; }
+  bool cutPending() const { return pending_ != nullptr; }
+  // Commit steps that waited for the worker, and the whole wait (wall time, ms).
+  int stalls() const { return stalls_; }
+  double stallMs() const { return stall_ms_; }
+  // Waits for the worker and commits a pending cut now (end of a run: its pass is reported).
+  void commitPendingCut();
+  // Testing: called on the worker before each cut job (see CutWorker::setDelayForTesting).
+  void setCutDelayForTesting(std::function<void()> delay);
   bool loopInTissue() const { return loop_in_tissue_; }
   const LoopGeometry& loop() const { return loop_; }
   int topologyVersion() const { return topology_version_; }
-  const TissueCollision& collision() const { return collision_; }
+  const TissueCollision& collision() const { return tissue_->collision; }
   // Metrics of the run so far.
   double initialMyomaVolume() const { return initial_myoma_mm3_; }  // mm^3, rest shape
   double electrodeActiveSeconds() const { return electrode_active_s_; }
@@ -145,39 +115,17 @@ class Simulation {
   void computeContact();
   static void contactForces(void* self, const sim::NodeVectors& x, const sim::NodeVectors& v);
   void contactForces(const sim::NodeVectors& x, const sim::NodeVectors& v);
-  // Replaces the mesh (rest positions) and everything built from it; x, v (#N x 3) are the
-  // current positions and velocities (null: rest and zero).
-  // current positions and velocities (null: rest and zero). `timing` (optional) receives the
-  // wall time of the parts (model_ms, surface_ms, collision_ms, locator_ms, chips_ms).
-  Status setTopology(cutting::TetMesh rest_mesh, const sim::NodeVectors* x, const sim::NodeVectors* v,
-                     PassRecord* timing = nullptr);
-  // Everything built from mesh_ and state_.x for contact, collision and drawing: boundary
-  // faces, render surface, contact nodes, FCL hierarchy, tet locator, chips' cavity.
-  // `boundary` (optional, 4 #T): which tet faces (slot 4 t + k, face k opposite vertex k) lie
-  // on the boundary, when the caller knows; else they are found from mesh_.
-  Status rebuildGeometry(PassRecord* timing, const std::vector<std::uint8_t>* boundary = nullptr);
-  // rebuildGeometry's first part, for `mesh` at positions x (the next mesh_ and state_.x): the
-  // boundary faces, render surface and FCL hierarchy. It writes only those members
-  // (surface_*, collision_) and reads on_cut_ and scene_, so a pass runs it on a second
-  // thread beside the model update. Times surface_ms, collision_ms. (The tet locator is
-  // rebuildGeometry's, or the pass's background thread's.) `renumber` (optional, #N of the
-  // mesh the hierarchy was last built for): the node each of its nodes became in `mesh`, or
-  // -1; with it, the hierarchy's chunks whose faces did not change are kept (see
-  // TissueCollision::build).
-  Status buildGeometry(const cutting::TetMesh& mesh, const sim::NodeVectors& x, PassRecord* timing,
-                       const std::vector<std::uint8_t>* boundary, const std::vector<int>* renumber = nullptr);
-  // rebuildGeometry's second part, once mesh_, model_ and state_ are the new ones: contact
-  // nodes and forces, collision flags, chips' cavity, topology version.
-  void finishGeometry(PassRecord* timing);
-  // State for model_ and mesh_ with positions x and velocities v (null: rest, zero), keeping
-  // the step count, time and warnings; counts anchored and deformable elements.
-  void resetState(const sim::NodeVectors* x, const sim::NodeVectors* v);
-  bool isAnchored(const Eigen::Vector3d& rest) const;
-  static double tetQuality(const cutting::TetMesh& mesh, int t);  // q* = r_in / R_circ, rest shape
   // Does the loop touch the tissue this step? Its sweep since the last step against the
   // boundary (FCL), else whether the wire is buried (one point in a tet).
   bool loopTouchesTissue();
+  void advanceShaving();
+  // The pass ends: its sweep goes to the cut worker (or, in sync mode, is cut here), to be
+  // committed scene.cut.commit_steps steps later.
   void finishPass();
+  void failPass(const std::string& why);
+  // Swaps the worker's result in: the next tissue epoch, the state remapped from this step's
+  // positions and velocities, the serosa's node numbers, the chips.
+  void commitCut();
   // The cut surface in the rest shape, built while the pass runs: each new sweep row that lies
   // 0.3 mm or more (its middle point) from the last kept one is carried from the tissue as it
   // is at that step to the rest shape (mapToRest), so the cut follows the material the wire
@@ -194,35 +142,23 @@ class Simulation {
   // the same either way (locate() gives the lowest-numbered tet holding the point, whatever
   // the grid).
   bool mapRow(int row, const Eigen::Vector3d& shift, bool last_rows = false);
-  // The lookups mapToRest needs besides the locator, for mesh_ at positions x: the nearest
-  // surface node (over a copy of x, surface_nodes_) and a tet at each node. Built with the
-  // locator (after a pass: on its background thread).
-  void buildNearest(const cutting::TetMesh& mesh, const sim::NodeVectors& x);
   void checkPerforation();
 
   Scene scene_;
-  cutting::TetMesh mesh_;
-  sim::Model model_;
+  std::unique_ptr<Tissue> tissue_;  // the epoch being stepped
   sim::State state_;
-  std::unique_ptr<haptics::Device> device_;  // the scene's scripted device (hardware later)
+  std::unique_ptr<haptics::Device> device_;  // the scene's scripted device unless replaced
   haptics::ToolPose pose_;
 
-  cutting::Tris surface_faces_;                   // #B x 3 boundary faces, model node ids
-  std::vector<int> surface_nodes_;                // #V model node ids on the boundary
-  std::vector<std::uint32_t> surface_triangles_;  // #B*3 indices into surface_nodes_
-  std::vector<render::SurfaceMaterial> surface_material_;  // #V
-  std::vector<int> contact_nodes_;                // free surface nodes (contact candidates)
   sim::NodeVectors contact_force_;                // #N x 3, uN
   Eigen::Vector3d tool_force_n_{0, 0, 0};
+  Eigen::Matrix3d tool_stiffness_ = Eigen::Matrix3d::Zero();
   Eigen::Vector3d contact_shaft_a_{0, 0, 0}, contact_shaft_b_{0, 0, 0}, contact_loop_{0, 0, 0};  // this step's tool
   int contact_calls_ = 0;                         // substeps that computed contact this step
   render::SurfaceMesh tool_surface_;              // body frame
-  int num_anchored_ = 0;
-  int num_deformable_tets_ = 0;
 
   // Shaving.
   LoopGeometry loop_;
-  TissueCollision collision_;  // boundary faces, refitted only while the electrode is active
   SweptWire swept_wire_;       // the wire's motion in the last step
   bool collision_active_ = false;  // the hierarchy was refitted and is followed step by step
   // Whether the wire is buried (in the tissue, touching no surface), known since the last
@@ -230,40 +166,36 @@ class Simulation {
   // contact-free stretch is enough.
   bool buried_known_ = false;
   bool buried_ = false;
-  TetLocator locator_;
-  // The locator's build after a pass (see finishPass); waitLocator() joins it. Everything
-  // that reads locator_ (the buried test, the next pass, rebuildGeometry) waits first.
-  mutable std::thread locator_thread_;
-  void waitLocator() const;
-  // The second thread of finishPass (made at the first pass; it sleeps between passes).
-  std::unique_ptr<PassWorker> pass_worker_;
-  // anchor_distance_ and pieces_anchored_ of mesh_, face_next_ and anchored_ (cleared and
-  // false when face_next_ is unknown); with count, returns the number of pieces of mesh_
-  // (a whole labelling; -1: unknown), else 0.
-  int anchorPieces(bool count);
   Eigen::Matrix<double, Eigen::Dynamic, 3> wire_, previous_wire_;
   Sweep sweep_;
   std::vector<Eigen::Vector3d> rest_rows_;  // the open pass's kept rows, rest shape (mapSweepRows)
   int swept_rows_mapped_ = 0;               // sweep rows looked at by mapSweepRows
   Eigen::Vector3d kept_middle_{0, 0, 0};    // deformed middle point of the last kept row
   bool map_failed_ = false;                 // a point had no tissue to map to
-  sim::NodeVectors nearest_x_;              // positions the NearestPoint grid was built at
-  NearestPoint nearest_surface_;            // over surface_nodes_ at nearest_x_
-  std::vector<int> node_tet_;               // #N: a tet around each node (the last that has it)
   bool loop_in_tissue_ = false;
   bool cutting_ = false;
   int topology_version_ = 0;
   std::vector<PassRecord> passes_;
   std::string cut_dump_dir_;  // see setCutDumpDir
-  std::vector<std::uint8_t> on_cut_;  // #N: node lies on a cut surface (drawn as cut tissue)
-  std::vector<std::uint8_t> anchored_;  // #N: rest position in an anchor region (fixed)
-  std::vector<double> tet_quality_;     // #T: q* of each element (rest shape), for q_min
-  std::vector<int> face_next_;          // 4 #T: matchFaces' next of mesh_ (empty: unknown)
-  // #T: anchorDistance of mesh_ (empty: unknown), and whether every piece of mesh_ has an
-  // anchored node (then a pass searches for free pieces near its cut only, see finishPass).
-  // After a pass both are computed on the locator's background thread.
-  std::vector<int> anchor_distance_;
-  bool pieces_anchored_ = false;
+
+  // The cut in flight: its input and outcome, the step that commits it, and when its pass
+  // ended (wall time, for the latency). spent_ holds the last committed one, whose outcome
+  // now owns the previous epoch: the next job frees it on the worker.
+  struct PendingCut {
+    CutJobInput input;
+    CutOutcome outcome;
+    sim::NodeVectors contact_force;  // #N x 3 of the next epoch, zero
+    std::uint64_t commit_step = 0;
+    // The exit step's part of the pass's record (the outcome's is the worker's until then).
+    double time_s = 0.0, map_ms = 0.0, sweep_area_mm2 = 0.0;
+    std::int64_t exit_step = 0;
+    std::chrono::steady_clock::time_point exit_time;
+  };
+  std::unique_ptr<PendingCut> pending_, spent_;
+  std::unique_ptr<CutWorker> worker_;  // started with the first async pass
+  std::function<void()> cut_delay_;    // setCutDelayForTesting
+  int stalls_ = 0;
+  double stall_ms_ = 0.0;
   double initial_myoma_mm3_ = 0.0;
   double electrode_active_s_ = 0.0;
   double path_length_mm_ = 0.0;
