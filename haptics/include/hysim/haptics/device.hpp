@@ -15,6 +15,7 @@ struct DeviceInfo {
   Eigen::Vector3d workspace_min_mm{-100, -100, -100};  // reachable tip positions (world frame)
   Eigen::Vector3d workspace_max_mm{100, 100, 100};
   double max_force_n = 3.0;   // forces above this are clamped
+  double max_stiffness_n_per_mm = 1.0;  // stiffest spring the device renders without buzzing
   double rate_hz = 1000.0;    // update rate the device runs at
   int num_buttons = 1;        // button 0 is the cut pedal
 };
