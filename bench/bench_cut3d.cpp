@@ -11,7 +11,6 @@
 // means), update_cpu_med_ms (BM_Cut3DUpdate: the update's median thread CPU time, steadier
 // than the wall clock on a loaded machine). Medians over the repetitions (the `_median` rows). Run from anywhere:
 //   ./build/bench/bench_cut3d --benchmark_filter='BM_Cut3DUpdate/./././1'   (incremental)
-//   ./build/bench/bench_cut3d --benchmark_filter='BM_Cut3DUpdateTwoThreads'  (two threads)
 // BM_Cut3DReplay: recorded shaving passes (HYSIM_REPLAY_DIR, see below).
 // BM_Cut3DSurface: the same meshes cut by a curved swept strip (the shaving passes' surfaces):
 //   ./build/bench/bench_cut3d --benchmark_filter='BM_Cut3DSurface'
@@ -24,14 +23,12 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <functional>
 #include <string>
 #include <vector>
 
 #include "hysim/cutting/cut3d.hpp"
 #include "hysim/cutting/mesh_io.hpp"
 #include "hysim/cutting/mesh_stats.hpp"
-#include "hysim/engine/pass_worker.hpp"
 #include "hysim/sim/model.hpp"
 #include "hysim/sim/tissue_update3d.hpp"
 #include "replay_passes.hpp"
@@ -123,7 +120,8 @@ hysim::Status incrementalUpdate(const Prepared& p, const hysim::cutting::Cut3DRe
 // The steps' wall times (Cut3DReport's and CutUpdate3DReport's *_ms), summed over the
 // iterations and given as means per iteration: counters classify_ms (with the node -> tets
 // lists), snap_ms, separate_ms (subdivision and separation), collapse_ms, late_snap_ms and
-// move_ms (in optimize_ms), prepare_ms (the update's first part) and stability_ms.
+// move_ms (in optimize_ms), prepare_ms (the update's masses and springs around the cut) and
+// stability_ms.
 struct PhaseTimes {
   double classify = 0, snap = 0, separate = 0, collapse = 0, late_snap = 0, move = 0, prepare = 0, stability = 0;
   void add(const hysim::cutting::Cut3DReport& c, const hysim::sim::CutUpdate3DReport& u) {
@@ -228,88 +226,6 @@ BENCHMARK(BM_Cut3DUpdate)
                    {0, 1, 2, 3},
                    {static_cast<int>(CutMethod::Hybrid), static_cast<int>(CutMethod::Standard)},
                    {0, 1}})
-    ->Unit(benchmark::kMillisecond)
-    ->MinTime(0.2)
-    ->Repetitions(5)
-    ->ReportAggregatesOnly(true);
-
-// BM_Cut3DUpdate/m/p/0/1 on two threads: cut3d hands its work beside (its node -> tets
-// lists, half of each move iteration) to a PassWorker, as the simulator's pass does; then the
-// update's first part (prepareModelAfterCut3D) runs here and lends the worker its element
-// comparison and its springs (CutUpdate3DOptions::beside; the simulator's pass runs this part
-// on the worker while its own thread finds the pieces cut free, so there nothing is lent),
-// then this thread finds the anchored nodes, remaps the state and runs the second part. The
-// same model and state as BM_Cut3DUpdate's (updateModelAfterCut3D is the two parts).
-// Counters as there.
-void BM_Cut3DUpdateTwoThreads(benchmark::State& state) {
-  const Prepared& p = mesh(static_cast<int>(state.range(0)));
-  const int plane = static_cast<int>(state.range(1));
-  if (!p.ok) {
-    state.SkipWithError("cannot read or model the mesh (assets/uterus_myoma.msh, tests/data/cutting/uterus_20k.msh)");
-    return;
-  }
-  const auto surface = planeThrough(p.mesh, plane);
-  hysim::engine::PassWorker worker;
-  hysim::cutting::Cut3DOptions o;
-  o.method = CutMethod::Hybrid;
-  o.beside = worker.lend();
-  hysim::sim::CutUpdate3DOptions update;
-  update.beside = o.beside;
-  double cutMs = 0, optMs = 0, updMs = 0;
-  PhaseTimes phases;
-  hysim::sim::Model model;
-  std::vector<std::uint8_t> fixed;
-  auto noop = [] {};
-  for (auto _ : state) {
-    state.PauseTiming();
-    model = p.model;
-    worker.begin();  // (the simulator wakes it as the pass starts, before the sweep's mapping:
-    worker.wait(worker.post(noop));  // not timed here, and running when the cut starts)
-    state.ResumeTiming();
-    const auto t0 = std::chrono::steady_clock::now();
-    auto r = hysim::cutting::cut3d(p.mesh, surface, o);
-    const auto t1 = std::chrono::steady_clock::now();
-    if (!r.ok()) {
-      worker.end();
-      state.SkipWithError(r.error().c_str());
-      return;
-    }
-    hysim::sim::CutUpdate3DPrepared prepared;
-    const hysim::Status prepareStatus =
-        hysim::sim::prepareModelAfterCut3D(model, p.mesh, r->mesh, r->change, update, &prepared);
-    fixed.assign(static_cast<size_t>(r->mesh.numNodes()), 0);
-    for (int i = 0; i < p.mesh.numNodes(); ++i) {
-      const int j = r->change.node_old_to_new[i];
-      if (j >= 0) fixed[j] = p.model.fixed[i] ? 1 : 0;
-    }
-    auto s = hysim::sim::remapState3D(p.state, r->change);
-    hysim::sim::CutUpdate3DReport updateReport;
-    const hysim::Status st =
-        prepareStatus.ok()
-            ? hysim::sim::finishModelAfterCut3D(model, r->mesh, r->change, fixed, {}, update, prepared, &updateReport)
-            : prepareStatus;
-    const auto t2 = std::chrono::steady_clock::now();
-    worker.end();
-    if (!st.ok()) {
-      state.SkipWithError(st.error().c_str());
-      return;
-    }
-    benchmark::DoNotOptimize(s);
-    benchmark::DoNotOptimize(model);
-    cutMs += std::chrono::duration<double, std::milli>(t1 - t0).count();
-    updMs += std::chrono::duration<double, std::milli>(t2 - t1).count();
-    optMs += r->report.optimize_ms;
-    phases.add(r->report, updateReport);
-  }
-  const double n = static_cast<double>(state.iterations());
-  state.counters["cut_ms"] = cutMs / n;
-  state.counters["optimize_ms"] = optMs / n;
-  state.counters["update_ms"] = updMs / n;
-  phases.report(state, n);
-  state.SetLabel(p.name + " plane " + std::to_string(plane) + " hybrid, incremental update, two threads");
-}
-BENCHMARK(BM_Cut3DUpdateTwoThreads)
-    ->ArgsProduct({{0, 1}, {0, 1, 2, 3}})
     ->Unit(benchmark::kMillisecond)
     ->MinTime(0.2)
     ->Repetitions(5)

@@ -473,13 +473,6 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
   if (!input.X.allFinite()) return Error{"cut3d: non-finite node coordinates"};
   if (!(options.snap_region >= 0 && options.snap_region <= 0.5)) return Error{"cut3d: snap_region must be in [0, 0.5]"};
 
-  // Node -> tets (CSR) of the input mesh, all tets, each list ascending (see below where it is
-  // used): it reads the input only, so it is built beside the classification when options
-  // .beside lends a thread (here, first, when none is), and waited for before its first use
-  // (or any return).
-  StarLists stars;
-  LentJob starsJob(options.beside, [&input, N0, &stars] { buildStarLists(input.T, N0, &stars); });
-
   Cut3DResult result;
   TetMesh& out = result.mesh;  // written at Assemble
   Cut3DReport& report = result.report;
@@ -542,7 +535,7 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
     std::vector<std::uint8_t> seen(N0, 0);
     FlatMap<std::uint64_t, std::uint8_t, EdgeKeyHash> tested(kNoEdge);
     // Outcodes against the surface's box grown by 2 eps (bit per side and axis): a tet whose
-    // nodes share a bit lies beside that box, which is what mayTouch tests first.
+    // nodes share a bit lies outside that box, which is what mayTouch tests first.
     std::vector<std::uint8_t> outcode(N0);
     {
       const Eigen::Array3d blo = surface.bounds().min().array() - 2 * eps, bhi = surface.bounds().max().array() + 2 * eps;
@@ -617,7 +610,8 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
   // neighbours, subdivision and separation at the crossed tets and the nodes on the cut); the
   // optimisation takes the lists over, patched where the cut changed tets (one O(#T) build
   // for both).
-  starsJob.join();
+  StarLists stars;
+  buildStarLists(input.T, N0, &stars);
   const std::vector<std::int32_t>& starOff = stars.off;
   const StarVector& starTet = stars.star;
   lap(report.classify_ms);
@@ -1167,7 +1161,7 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
       const Vec3 centre = (a + b + c) / 3.0;
       if (!surface.within(centre, eps + 0.05 * size)) {
         // On a curved surface a flat face with its corners on the surface lies off it by the
-        // sagitta (about size^2 / (8 R)), and a thin tet beside it may lie wholly on the far
+        // sagitta (about size^2 / (8 R)), and a thin tet next to it may lie wholly on the far
         // side of the surface. The face is still on the cut when the surface passes between
         // the two tets there: the segment between their vertices opposite the face (or,
         // where one of those is on the surface, between their centroids) crosses it near
@@ -1407,12 +1401,8 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
       region.edge_length += (input.X.row(ce.a) - input.X.row(ce.b)).norm() / static_cast<double>(crossed.size());
     region.seeds.insert(region.seeds.end(), moved.begin(), moved.end());
     // The input's lists, patched to the output mesh (the rows the cut wrote, the appended
-    // tets); the optimisation takes them over. Beside them (both only read `out`), the mesh's
-    // volume for the optimisation's budgets.
-    {
-      LentJob volumeJob(options.beside, [&out, &region] { region.mesh_volume = optimizeMeshVolume(out); });
-      patchStarLists(input.T, out.T, N1, std::move(w.changedTets), &stars);
-    }
+    // tets); the optimisation takes them over.
+    patchStarLists(input.T, out.T, N1, std::move(w.changedTets), &stars);
 #ifdef HYSIM_CHECK_EXACT
     {
       StarLists full;
@@ -1450,7 +1440,6 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
     }
     const size_t before = moved.size();
     OptimizeCounts counts;
-    region.beside = options.beside;
     optimizeAroundCut(out, region, options.optimize, &moved, &peeled, &counts);
     if (region.left_alone != nullptr)
       for (size_t t = 0; t < cutOffTets.size(); ++t)

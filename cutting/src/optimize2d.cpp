@@ -407,8 +407,7 @@ bool tryFlip(Work& w, const RepairContext& rc, int x, int y) {
 
 void bandNodes(const Work& w, const Chains& chains, int rings, std::vector<int>& out) {
   out.clear();
-  static thread_local std::vector<char> seen;
-  seen.assign(w.nodes.size(), 0);
+  std::vector<char> seen(w.nodes.size(), 0);
   std::vector<int> frontier, next, nb;
   for (const auto& ch : chains)
     for (int n : ch)

@@ -270,8 +270,8 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   };
   buildStars();
   // Peeling and collapses change the volume; together they may change it by at most
-  // volume_budget of the mesh's volume (optimizeMeshVolume; cut3d computes it beside).
-  const double meshVolume = std::isnan(region.mesh_volume) ? optimizeMeshVolume(mesh) : region.mesh_volume;
+  // volume_budget of the mesh's volume.
+  const double meshVolume = optimizeMeshVolume(mesh);
   // Curved cuts: the budgets bound the net change of the mesh volume (collapses and moves
   // add and remove volume; what they move about cancels) and, at volume_churn_factor x
   // that, the sum of the absolute changes. Plane cuts: the sum of the absolute changes.
@@ -334,13 +334,10 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     double q;
     std::int8_t up;  // tetVolume6Here > 0 at these positions (1, 0), -1: not asked yet
   };
-  // (At most one entry per tet. The move loop's two lanes (see there) take new entries from
-  // the two ends: lane 0 from the front, lane 1 from the back, so neither writes where the
-  // other does; which slot an entry has changes nothing else.)
+  // (At most one entry per tet, in the order first asked.)
   std::vector<std::int32_t> qSlot(M, -1);
   std::vector<QEntry, NoInitAllocator<QEntry>> qPool(static_cast<size_t>(M));
-  std::int32_t qNext[2] = {0, M - 1};
-  auto newQSlot = [&](int lane) { return lane == 0 ? qNext[0]++ : qNext[1]--; };
+  std::int32_t qNext = 0;
   auto tetQ = [&](int t) {
     QEntry cur;
     for (int k = 0; k < 4; ++k) {
@@ -352,7 +349,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       const QEntry& e = qPool[slot];
       if (std::equal(cur.v, cur.v + 4, e.v) && std::equal(cur.ver, cur.ver + 4, e.ver)) return e.q;
     } else {
-      slot = newQSlot(0);
+      slot = qNext++;
     }
     cur.q = radiusRatio(pos(cur.v[0]), pos(cur.v[1]), pos(cur.v[2]), pos(cur.v[3]));
     cur.up = -1;
@@ -361,7 +358,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   };
   // vol6 > 0 ? tetQ(t) : -1 (vol6 = tetVolume6Here(mesh, t)), the sign cached with q*.
   // (An entry is only made where vol6 > 0, as tetQ is only asked there.)
-  auto tetQUp = [&](int t, int lane = 0) {
+  auto tetQUp = [&](int t) {
     QEntry cur;
     for (int k = 0; k < 4; ++k) {
       cur.v[k] = mesh.T(t, k);
@@ -376,7 +373,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       }
     }
     if (!(tetVolume6Here(mesh, t) > 0)) return -1.0;
-    if (slot < 0) slot = newQSlot(lane);
+    if (slot < 0) slot = qNext++;
     cur.q = radiusRatio(pos(cur.v[0]), pos(cur.v[1]), pos(cur.v[2]), pos(cur.v[3]));
     cur.up = 1;
     qPool[slot] = cur;
@@ -393,12 +390,12 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     return radiusRatioOriented(pos(a), pos(b), pos(c), pos(d));
   };
   // Worst q* around n where it is (tetQAt at its own position, through the cache).
-  auto starWorst = [&](int n, int* worstTet, int lane = 0) {
+  auto starWorst = [&](int n, int* worstTet) {
     double q = 1.0;
     for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s) {
       const int t = (*s);
       if ((*dead)[t]) continue;
-      const double qt = tetQUp(t, lane);  // -1 where not (p1 - p0).dot((p2 - p0).cross(p3 - p0)) > 0
+      const double qt = tetQUp(t);  // -1 where not (p1 - p0).dot((p2 - p0).cross(p3 - p0)) > 0
       if (qt < q) {
         q = qt;
         if (worstTet) *worstTet = (*s);
@@ -455,37 +452,34 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     Vec3 area;  // outward area vector (x2 the area)
     Vec3 unit;  // area.normalized()
   };
-  // constraintOf's scratch, one per lane of the move loop (lane 0 everywhere else):
-  //  - a node's neighbours, their local numbers (-1 elsewhere; lane 0's also discAround's), a
-  //    table over pairs of them;
+  // constraintOf's scratch:
+  //  - a node's neighbours, their local numbers (-1 elsewhere; also discAround's), a table
+  //    over pairs of them;
   //  - the faces by pair (consFaces), per live star tet its tet, then its nodes' local numbers
   //    (n: -1) (consLocal);
   //  - the boundary faces (faces) and, for Fan, their corners (fan);
-  //  - the kept boundary faces of the nodes this lane looked at (bfPool, see bfStart).
-  struct ConsLane {
+  //  - the kept boundary faces of the nodes looked at (bfPool, see bfStart).
+  struct ConsScratch {
     std::vector<std::int32_t> nbrs, localId, pairCount, consLocal;
     std::vector<FaceUse> consFaces;
     std::vector<BFace> faces;
     std::vector<std::array<Vec3, 3>> fan;
     std::vector<std::array<std::int32_t, 2>> bfPool;
   };
-  ConsLane consLane[2];
-  consLane[0].localId.assign(N, -1);
-  std::vector<std::int32_t>& localId = consLane[0].localId;
+  ConsScratch cons;
+  cons.localId.assign(N, -1);
+  std::vector<std::int32_t>& localId = cons.localId;
   // The move loop changes positions only, never which tets are live or their nodes, so the
   // boundary faces around a node, as (tet, face) in the order first seen, are the same at
-  // every call there: kept per node (bfStart[n] >= 0: bfLen[n] entries of lane bfLane[n]'s
-  // bfPool from there). Empty bfStart: no keeping (the mesh may change between calls).
+  // every call there: kept per node (bfStart[n] >= 0: bfLen[n] entries of bfPool from
+  // there). Empty bfStart: no keeping (the mesh may change between calls).
   std::vector<std::int32_t> bfStart, bfLen;
-  std::vector<std::uint8_t> bfLane;
-  bool lanesApart = false;  // the move loop's lanes run side by side now
-  auto constraintOf = [&](int n, int lane = 0) {
-    ConsLane& S = consLane[lane];
+  auto constraintOf = [&](int n) {
+    ConsScratch& S = cons;
     Constraint c;
     S.faces.clear();
     const bool keep = !bfStart.empty();
-    // (A lane beside the other keeps its own copy: the other's pool may grow meanwhile.)
-    if (!keep || bfStart[n] < 0 || (lanesApart && bfLane[n] != lane)) {
+    if (!keep || bfStart[n] < 0) {
       if (!keep) S.bfPool.clear();
       S.consFaces.clear();
       // Faces by the pair of their nodes other than n (local numbers over n's neighbours).
@@ -535,10 +529,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
         }
       }
       for (int w : S.nbrs) S.localId[w] = -1;
-      if (keep) {
-        bfStart[n] = static_cast<std::int32_t>(S.bfPool.size());
-        bfLane[n] = static_cast<std::uint8_t>(lane);
-      }
+      if (keep) bfStart[n] = static_cast<std::int32_t>(S.bfPool.size());
       for (const FaceUse& fu : S.consFaces) {
         S.pairCount[fu.key] = -1;
         if (fu.count != 1) continue;
@@ -549,7 +540,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     Vec3 sum = Vec3::Zero();
     bool boundary = false, allCut = true;
     const std::int32_t bfFrom = keep ? bfStart[n] : 0;
-    const auto& bfPool = keep ? consLane[bfLane[n]].bfPool : S.bfPool;
+    const auto& bfPool = S.bfPool;
     const std::int32_t bfTo = keep ? bfStart[n] + bfLen[n] : static_cast<std::int32_t>(bfPool.size());
     for (std::int32_t bi = bfFrom; bi < bfTo; ++bi) {
       const int t = bfPool[bi][0], f = bfPool[bi][1];
@@ -1857,21 +1848,20 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     Vec3 closest;
     std::int8_t kind;  // 0 none, 1 exact, 2 lower bound (set when the entry is made)
   };
-  // (At most one entry per node; the move loop's lanes take new ones from the two ends, as
-  // qPool's.)
+  // (At most one entry per node, in the order first asked.)
   std::vector<std::int32_t> distSlot;
   std::vector<DistEntry, NoInitAllocator<DistEntry>> distPool;
-  std::int32_t distNext[2] = {0, N - 1};
-  auto distInit = [&] {  // (before the move loop's lanes ask: they must not both make the tables)
+  std::int32_t distNext = 0;
+  auto distInit = [&] {
     if (!distSlot.empty()) return;
     distSlot.assign(N, -1);
     distPool.resize(N);
   };
-  auto distEntry = [&](int n, int lane = 0) -> DistEntry& {
+  auto distEntry = [&](int n) -> DistEntry& {
     distInit();
     std::int32_t& slot = distSlot[n];
     if (slot < 0) {
-      slot = lane == 0 ? distNext[0]++ : distNext[1]--;
+      slot = distNext++;
       distPool[slot].kind = 0;
     }
     DistEntry& e = distPool[slot];
@@ -1882,8 +1872,8 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   // known to be within (within() said so, or n is on the cut and `within` the on-surface
   // tolerance), for the bounded search, which gives signedDistance's value and point (and
   // searches everything after all where nothing is that near).
-  auto nodeDistance = [&](int n, Vec3* closest, double within = std::numeric_limits<double>::infinity(), int lane = 0) {
-    DistEntry& e = distEntry(n, lane);
+  auto nodeDistance = [&](int n, Vec3* closest, double within = std::numeric_limits<double>::infinity()) {
+    DistEntry& e = distEntry(n);
     if (e.kind != 1) {
       e.x = pos(n);
       e.d = std::abs(region.surface->signedDistanceNear(e.x, within, &e.closest));
@@ -1893,8 +1883,8 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     return e.d;
   };
   // region.surface->within(pos(n), r).
-  auto nodeWithin = [&](int n, double r, int lane = 0) {
-    DistEntry& e = distEntry(n, lane);
+  auto nodeWithin = [&](int n, double r) {
+    DistEntry& e = distEntry(n);
     if (e.kind == 1) return e.d <= r;
     if (e.kind == 2 && r <= e.d) return false;
     const bool in = region.surface->within(pos(n), r);
@@ -2148,12 +2138,9 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   timed(&OptimizeCounts::collapse_ms, collapseEdges);
   flips();
 
-  // Nodes up to `rings` edge steps from the seeds may move (found on region.beside's thread
-  // where given, while this one finds the poor tets around the seeds below: it reads the
-  // tets' nodes and the node -> tets lists, which nothing writes meanwhile, and writes only
-  // `ring`).
+  // Nodes up to `rings` edge steps from the seeds may move.
   std::vector<std::int8_t> ring(N, -1);
-  auto findRings = [&] {
+  {
     std::vector<std::int32_t> frontier, next;
     for (int n : seeds)
       if (n >= 0 && n < N && ring[n] < 0) {
@@ -2173,7 +2160,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
           }
       frontier.swap(next);
     }
-  };
+  }
   // Work list: the nodes of poor elements around the seeds.
   std::vector<std::int32_t> stamp(N, -1), work;
   auto addNodesOf = [&](int t, int round) {  // t's nodes within the rings, each once a round
@@ -2195,13 +2182,10 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
   {
     // (As addBadAround(n, 0) for each seed n: the poor tets met, in order, then their nodes.)
     std::vector<std::int32_t> poor;
-    {
-      LentJob ringsJob(region.beside, findRings);
-      for (int n : seeds)
-        if (n >= 0 && n < N)
-          for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s)
-            if (!(*dead)[*s] && tetQ(*s) < options.quality_target) poor.push_back(*s);
-    }
+    for (int n : seeds)
+      if (n >= 0 && n < N)
+        for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s)
+          if (!(*dead)[*s] && tetQ(*s) < options.quality_target) poor.push_back(*s);
     for (const int t : poor) addNodesOf(t, 0);
   }
   std::vector<std::uint8_t> didMove(N, 0);
@@ -2212,34 +2196,31 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     double old;        // its volume where n is
     int kn;            // n's corner
   };
-  // The move loop's two lanes (see moveRun): what each gathers and its scratch.
-  struct MoveLane {
-    std::vector<std::int32_t> moved;  // the nodes it moved, in order
-    std::vector<double> starVolume;   // per node, filled when first needed
+  // The move loop's scratch, what an iteration gathers, and what the part being moved spent.
+  struct MoveScratch {
+    std::vector<double> starVolume;  // per node, filled when first needed
     std::vector<StarVolTet> starVol;
     double largest = 0, scale = 0;
-    bool split = false;      // beside the other lane: the budget's half, its own version numbers
-    double net = 0, churn = 0;  // (split) the volume change it spent
-    std::uint32_t nextVer = 0;  // (split) the next version number it gives a node
+    bool split = false;         // moving a part (see moveRun): half the budget left at its start
+    double net = 0, churn = 0;  // (split) the volume change the part spent
   };
-  MoveLane moveLane[2];
-  // Does a move's volume change dv fit the move budget? Beside the other lane, a lane has half
-  // the room left at the start: |net + 2 (its net + dv)| <= limit and the same for the churn,
-  // so whatever both spend, the sum fits (the halves' mean does), in any order.
-  auto moveFits = [&](const MoveLane& L, double dv) {
-    if (!L.split) return moveBudget.fits(dv);
-    return std::abs(moveBudget.net + 2.0 * (L.net + dv)) <= moveBudget.limit &&
-           moveBudget.churn + 2.0 * (L.churn + std::abs(dv)) <= moveBudget.churn_factor * moveBudget.limit;
+  MoveScratch mv;
+  // Does a move's volume change dv fit the move budget? A part of a split has half the room
+  // left at the split's start: |net + 2 (its net + dv)| <= limit and the same for the churn,
+  // so whatever both parts spend, the sum fits (the halves' mean does).
+  auto moveFits = [&](double dv) {
+    if (!mv.split) return moveBudget.fits(dv);
+    return std::abs(moveBudget.net + 2.0 * (mv.net + dv)) <= moveBudget.limit &&
+           moveBudget.churn + 2.0 * (mv.churn + std::abs(dv)) <= moveBudget.churn_factor * moveBudget.limit;
   };
-  // One node's move (the file comment), on lane `lane`: it reads the positions of n and its
-  // neighbours and writes n's.
-  auto moveNode = [&](int n, int lane) {
-    MoveLane& L = moveLane[lane];
+  // One node's move (the file comment): it reads the positions of n and its neighbours and
+  // writes n's; appends n to movedNow where it moved.
+  auto moveNode = [&](int n) {
     // (The cached quality test before the constraint, which looks at the whole star.)
     int wt = -1;
-    const double before = starWorst(n, &wt, lane);
+    const double before = starWorst(n, &wt);
     if (before < 0 || before >= options.quality_target || wt < 0) return;
-    const Constraint c = constraintOf(n, lane);
+    const Constraint c = constraintOf(n);
     if (c.kind == Freedom::Fixed) return;
     const Vec3 x = pos(n);
     auto project = [&](Vec3 d) {
@@ -2267,7 +2248,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     }
     if (deg == 0) return;
     const double h = sum / deg;
-    L.scale = std::max(L.scale, h);
+    mv.scale = std::max(mv.scale, h);
     for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s) {
       if ((*dead)[(*s)]) continue;
       for (int k = 0; k < 4; ++k) {
@@ -2325,16 +2306,16 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     // y := its nearest point of the cut, which lies within |y - x| + dist(x) of y: the
     // search looks no farther (the same point as a full search).
     auto onCutAgain = [&](Vec3& y) {
-      const double r = (y - x).norm() + nodeDistance(n, nullptr, onCut[n] ? region.eps : std::numeric_limits<double>::infinity(), lane);
+      const double r = (y - x).norm() + nodeDistance(n, nullptr, onCut[n] ? region.eps : std::numeric_limits<double>::infinity());
       region.surface->signedDistanceNear(Vec3(y), r, &y);
     };
     int farFromCut = curved && !onCut[n] ? -1 : 0;  // -1: not asked yet
-    L.starVolume.clear();
+    mv.starVolume.clear();
     auto sideOk = [&](const Vec3& y) {
       if (farFromCut < 0) {
         double reach = 0;
         for (const Vec3& d : dirs) reach = std::max(reach, d.norm());
-        farFromCut = nodeWithin(n, 2.0 * reach + 4.0 * region.eps, lane) ? 0 : 1;
+        farFromCut = nodeWithin(n, 2.0 * reach + 4.0 * region.eps) ? 0 : 1;
       }
       return farFromCut == 1 || sideKept(n, x, y);
     };
@@ -2365,7 +2346,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
         if (c.kind == Freedom::Fan) {
           Vec3 best = y;
           double bestD = std::numeric_limits<double>::infinity();
-          for (const auto& tri : consLane[lane].fan) {
+          for (const auto& tri : cons.fan) {
             const Vec3 z = closestPointOnTriangle(y, tri[0], tri[1], tri[2]);
             const double dz = (z - y).squaredNorm();
             if (dz < bestD) {
@@ -2384,16 +2365,16 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
         // Moves on a curved surface change the volume a little (the faces are chords): within the budget.
         double dv = 0;
         if (curved && (c.kind == Freedom::Surface || c.kind == Freedom::Fan || c.kind == Freedom::Ridge)) {
-          if (L.starVolume.empty()) {  // the star's volumes where n is (the same for every candidate)
+          if (mv.starVolume.empty()) {  // the star's volumes where n is (the same for every candidate)
             // With them, per live star tet the parts of its volume expression that do not
             // depend on n's position (the corners, the differences and the cross product of
             // the fixed corners: the same operations on the same values as below).
             const double* cx = mesh.X.col(0).data();
             const double* cy = mesh.X.col(1).data();
             const double* cz = mesh.X.col(2).data();
-            L.starVol.clear();
+            mv.starVol.clear();
             for (const std::int32_t *s = starB(n), *sEnd = starE(n); s < sEnd; ++s) {
-              L.starVolume.push_back((*dead)[*s] ? 0.0 : tetVolumeHere(mesh, *s));
+              mv.starVolume.push_back((*dead)[*s] ? 0.0 : tetVolumeHere(mesh, *s));
               if ((*dead)[*s]) continue;
               StarVolTet sv;
               double px[4], py[4], pz[4];
@@ -2405,7 +2386,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
                 py[k] = cy[v];
                 pz[k] = cz[v];
               }
-              sv.old = L.starVolume.back();
+              sv.old = mv.starVolume.back();
               for (int k = 0; k < 4; ++k) {
                 sv.p[0][k] = px[k];
                 sv.p[1][k] = py[k];
@@ -2419,12 +2400,12 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
                 const double ex = sv.e[0], ey = sv.e[1], ez = sv.e[2];
                 sv.nrm[0] = by * ez - bz * ey, sv.nrm[1] = bz * ex - bx * ez, sv.nrm[2] = bx * ey - by * ex;
               }
-              L.starVol.push_back(sv);
+              mv.starVol.push_back(sv);
             }
           }
           // (The volume of each tet with n at y in scalars, as tetVolumeHere: the same value
           // as the vector expression (p1 - p0).dot((p2 - p0).cross(p3 - p0)).)
-          for (const StarVolTet& sv : L.starVol) {
+          for (const StarVolTet& sv : mv.starVol) {
             double ax, ay, az, bx, by, bz, ex, ey, ez, vol6;
             if (sv.kn == 0) {
               ax = sv.p[0][1] - y[0], ay = sv.p[1][1] - y[1], az = sv.p[2][1] - y[2];
@@ -2456,7 +2437,7 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
 #endif
             dv += vol6 / 6.0 - sv.old;
           }
-          if (!moveFits(L, dv) || std::abs(dv) > options.move_volume_fraction * edgeTet) continue;
+          if (!moveFits(dv) || std::abs(dv) > options.move_volume_fraction * edgeTet) continue;
         }
         if (!sideOk(y)) continue;
         double q = 0;
@@ -2469,27 +2450,24 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
       }
     }
     if (best > before) {
-      L.largest = std::max(L.largest, (bestX - x).norm());
-      if (L.split) {
-        L.net += bestDv;
-        L.churn += std::abs(bestDv);
-        mesh.X.row(n) = bestX.transpose();
-        nodeVer[n] = L.nextVer;
-        L.nextVer += 2;
+      mv.largest = std::max(mv.largest, (bestX - x).norm());
+      if (mv.split) {
+        mv.net += bestDv;
+        mv.churn += std::abs(bestDv);
       } else {
         moveBudget.spend(bestDv);
-        setPos(n, bestX);
       }
+      setPos(n, bestX);
       didMove[n] = 1;
-      L.moved.push_back(n);
+      movedNow.push_back(n);
     }
   };
-  // The move loop's nodes, in parts that can move side by side: after splitWork(list),
-  // partA and partB (each in list order) have no two nodes that are neighbours (share a tet),
-  // so neither part's moves read a position the other's write, and partS holds the rest. A
-  // sort along an axis by position puts the nodes ranked below k on the left; partA is those
-  // whose neighbours in the list are all on the left too, partB the right, partS the left
-  // ones with a neighbour on the right. k makes max(|A|, |B|) + |S| smallest.
+  // The move loop's nodes in parts: after splitWork(list), partA and partB (each in list
+  // order) have no two nodes that are neighbours (share a tet), so neither part's moves read
+  // a position the other's write, and partS holds the rest. A sort along an axis by position
+  // puts the nodes ranked below k on the left; partA is those whose neighbours in the list
+  // are all on the left too, partB the right, partS the left ones with a neighbour on the
+  // right. k makes max(|A|, |B|) + |S| smallest.
   // False where the list is too short to be worth it or no split leaves both parts nodes.
   std::vector<std::int32_t> workAt(N, -1);  // place in the list being split, -1 elsewhere
   // Per node looked at: its neighbours, ringLen[n] entries of ringPool from ringStart[n] (-1: not yet).
@@ -2567,60 +2545,40 @@ void optimizeAroundCut(TetMesh& mesh, const CutRegion& region, const Optimize3DO
     }
     return true;
   };
-  // Moves the nodes of `list` (no repeats), appending the moved ones to movedNow: parts A and B
-  // side by side (B on region.beside's thread where given), then the rest the same way, and
-  // the last part (too short to split) one node after another. The result is that of moving
-  // A, then B, then the rest in order, whichever thread ran what: the parts share no
-  // neighbours and each has half the move budget left at its start (moveFits).
+  // Moves the nodes of `list` (no repeats), appending the moved ones to movedNow: part A,
+  // then part B, each with half of the move budget left at the split's start (moveFits; both
+  // spend it only after B), then the rest the same way, and the last part (too short to
+  // split) one node after another.
   std::vector<std::int32_t> moveRest;
   auto moveRun = [&](const std::vector<std::int32_t>& list) {
     moveRest = list;
     while (splitWork(moveRest)) {
-      lanesApart = true;
+      double net[2], churn[2];
+      mv.split = true;
       for (int k = 0; k < 2; ++k) {
-        MoveLane& L = moveLane[k];
-        L.split = true;
-        L.net = L.churn = 0;
-        L.moved.clear();
-        L.nextVer = verClock + 1 + static_cast<std::uint32_t>(k);  // lane 0 odd, lane 1 even steps from here
+        mv.net = mv.churn = 0;
+        for (int n : k == 0 ? partA : partB) moveNode(n);
+        net[k] = mv.net;
+        churn[k] = mv.churn;
       }
-      auto runB = [&] {
-        for (int n : partB) moveNode(n, 1);
-      };
-      if (region.beside) {
-        LentJob partBJob(region.beside, runB);  // (part B uses this frame: waited for on every way out)
-        for (int n : partA) moveNode(n, 0);
-      } else {
-        for (int n : partA) moveNode(n, 0);
-        runB();
-      }
-      lanesApart = false;
-      for (MoveLane& L : moveLane) {
-        L.split = false;
-        moveBudget.net += L.net;
-        moveBudget.churn += L.churn;
-        movedNow.insert(movedNow.end(), L.moved.begin(), L.moved.end());
-        verClock = std::max(verClock, L.nextVer);
+      mv.split = false;
+      for (int k = 0; k < 2; ++k) {
+        moveBudget.net += net[k];
+        moveBudget.churn += churn[k];
       }
       moveRest.swap(partS);
     }
-    moveLane[0].moved.clear();
-    for (int n : moveRest) moveNode(n, 0);
-    movedNow.insert(movedNow.end(), moveLane[0].moved.begin(), moveLane[0].moved.end());
+    for (int n : moveRest) moveNode(n);
   };
   int it = 0;
   bfStart.assign(N, -1);  // constraintOf keeps the boundary faces per node (see there)
   bfLen.assign(N, 0);
-  bfLane.assign(N, 0);
-  for (ConsLane& cl : consLane) cl.bfPool.clear();
-  consLane[1].localId.assign(N, -1);
-  if (region.surface != nullptr) distInit();  // (the lanes' nodeDistance, nodeWithin)
+  cons.bfPool.clear();
   for (; it < options.max_iterations && !work.empty(); ++it) {
-    for (MoveLane& L : moveLane) L.largest = L.scale = 0;
+    mv.largest = mv.scale = 0;
     movedNow.clear();
     timed(&OptimizeCounts::move_ms, [&] { moveRun(work); });
-    const double largest = std::max(moveLane[0].largest, moveLane[1].largest);
-    const double scale = std::max(moveLane[0].scale, moveLane[1].scale);
+    const double largest = mv.largest, scale = mv.scale;
     work.clear();
     for (int n : movedNow) addBadAround(n, it + 1);
     if (largest <= options.stop_fraction * scale) {

@@ -5,8 +5,6 @@
 #include <algorithm>
 #include <bit>
 #include <cstdint>
-#include <functional>
-#include <limits>
 #include <memory>
 #include <new>
 #include <utility>
@@ -74,16 +72,12 @@ struct CutRegion {
   std::vector<std::int32_t> seeds;      // nodes the cut created, moved or separated
   std::vector<std::uint8_t> on_cut;     // #N of the output mesh: node lies on the cut
   double edge_length = 0;               // mean length of the crossed edges (the local mesh size)
-  // Optional: optimizeMeshVolume(mesh) computed beforehand (NaN: optimizeAroundCut computes it).
-  double mesh_volume = std::numeric_limits<double>::quiet_NaN();
   // Optional: the output mesh's node -> tet lists (cut3d: the input's, patched where the cut
   // changed tets), which optimizeAroundCut takes over (moved from) instead of building them.
   StarLists* stars = nullptr;
   // Optional (#T): tets left as they are (pieces the cut cut off), as if already removed:
   // no operation reads or changes them. They start marked in *dead (the caller unmarks them).
   const std::vector<std::uint8_t>* left_alone = nullptr;
-  // Optional: Cut3DOptions::beside, for the move loop's second lane.
-  Beside beside;
 };
 
 struct OptimizeCounts {

@@ -350,23 +350,28 @@ std::vector<ChipShape> chipShapes(const cutting::TetMesh& after, const sim::Node
   return out;
 }
 
-// The chips as they are at the exit step: the cut mesh at the exit positions (the state
-// mapped through the cut), each free piece with its mean velocity.
-void makeChips(const Scene& scene, const Tissue& base, const cutting::TetMesh& after,
-               const cutting::TopologyChange& change, const Kept& k, const std::vector<std::uint8_t>& on_cut,
-               const CutJobInput& in, CutOutcome& out) {
+// What the chips are made of at the commit step.
+void keepChipSource(const Tissue& base, const cutting::TetMesh& after, const cutting::TopologyChange& change,
+                    const Kept& k, const std::vector<std::uint8_t>& on_cut, CutOutcome& out) {
   std::vector<std::int32_t> every(static_cast<size_t>(after.numNodes()));
   for (int i = 0; i < after.numNodes(); ++i) every[i] = i;
-  StateRemap whole;
-  buildRemap(base, after, change, every, after.numNodes(), whole);
-  sim::NodeVectors x(after.numNodes(), 3), v(after.numNodes(), 3);
-  whole.apply(in.x, in.v, x, v);
-  cutting::TetMesh deformed = after;
-  deformed.X = x;
-  out.chips = chipShapes(deformed, v, k.comps, on_cut, scene.materials, myomaLabel(scene));
+  buildRemap(base, after, change, every, after.numNodes(), out.chips.remap);
+  out.chips.mesh = after;
+  out.chips.pieces = k.comps;
+  out.chips.on_cut = on_cut;
 }
 
 }  // namespace
+
+std::vector<ChipShape> chipsAt(const ChipSource& source, const Scene& scene, const sim::NodeVectors& x,
+                               const sim::NodeVectors& v) {
+  const int n = source.mesh.numNodes();
+  sim::NodeVectors xs(n, 3), vs(n, 3);
+  source.remap.apply(x, v, xs, vs);
+  cutting::TetMesh deformed = source.mesh;
+  deformed.X = xs;
+  return chipShapes(deformed, vs, source.pieces, source.on_cut, scene.materials, myomaLabel(scene));
+}
 
 void runCutJob(const Tissue& base, const Scene& scene, const CutJobInput& in, CutOutcome& out) {
   StageTimer timer;
@@ -443,7 +448,7 @@ void runCutJob(const Tissue& base, const Scene& scene, const CutJobInput& in, Cu
   }
   sim::NodeVectors x_kept(k.nodes, 3), v_kept(k.nodes, 3);
   out.remap.apply(in.x, in.v, x_kept, v_kept);
-  if (scene.chips.mode == ChipSettings::Mode::Simulate) makeChips(scene, base, after, change, k, on_cut, in, out);
+  if (scene.chips.mode == ChipSettings::Mode::Simulate && rec.chips > 0) keepChipSource(base, after, change, k, on_cut, out);
   timer.lap(&rec.chips_ms);
   if (Status st = buildSurface(*next, scene, x_kept, boundary.empty() ? nullptr : &boundary, &rec); !st.ok()) {
     return fail(st.error());

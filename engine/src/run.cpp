@@ -1,5 +1,5 @@
 // engine::run: the fixed-step loop of `hysim run`, headless, as fast as possible or paced to
-// the wall clock with the haptic thread beside it.
+// the wall clock with the haptic thread alongside.
 #include <algorithm>
 #include <chrono>
 #include <memory>

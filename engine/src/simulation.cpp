@@ -438,6 +438,9 @@ void Simulation::commitCut() {
   rec.stall_ms = stall_ms;
   rec.stalled = stall_ms > 0.0;
   if (out.status.ok()) {
+    // Chips start where their pieces are now (simulated chips only; this allocates).
+    std::vector<ChipShape> chips;
+    if (chips_ && out.record.chips > 0) chips = chipsAt(out.chips, scene_, state_.x, state_.v);
     // The state of this step carried into the next epoch's numbering, in buffers sized there.
     out.remap.apply(state_.x, state_.v, out.state.x, out.state.v);
     out.state.steps = state_.steps;
@@ -453,7 +456,7 @@ void Simulation::commitCut() {
     ++topology_version_;
     if (chips_) {
       chips_->setCavity(state_.x, tissue_->surface_faces);
-      for (const ChipShape& chip : out.chips) chips_->addChip(chip);
+      for (const ChipShape& chip : chips) chips_->addChip(chip);
     }
   }
   const auto t2 = std::chrono::steady_clock::now();

@@ -2,14 +2,12 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <array>
-#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <functional>
 #include <immintrin.h>
 #include <limits>
 #include <memory>
-#include <optional>
 #include <string>
 
 #include "hysim/sim/tissue_update3d.hpp"
@@ -247,34 +245,38 @@ void lanczosNext(Eigen::Index n, const double* z, double b, double* q, double* c
   (avx2 ? nextAvx2 : nextBaseline)(n, z, b, q, column);
 }
 
-// Resets a table of local numbers (-1 between uses) at `nodes` when it goes out of scope,
-// once armed.
+// Resets a table of local numbers (-1 between uses) at `nodes` when it goes out of scope.
 struct ResetLocal {
   std::vector<int>& local;
   const std::vector<int>& nodes;
-  bool armed = true;
   ~ResetLocal() {
-    if (armed)
-      for (int node : nodes) local[node] = -1;
+    for (int node : nodes) local[node] = -1;
   }
 };
 
-// The springs at each estimate node, in increasing spring order (the order StepSprings lists
-// them in, so that the sums over them are the same to the last bit): those of nodes[k] are
-// spring[e] for first[i] <= e < first[i + 1], with i = nodes[k] (StepSprings' own lists) or
-// i = k (lists of the estimate nodes only), with ends a, b and stiffness k.
+// The springs at each node, in increasing spring order (StepSprings' lists, so that the sums
+// over them are the same to the last bit): those of node i are spring[e] for
+// first[i] <= e < first[i + 1], with ends a, b and stiffness k.
 struct NodeSprings {
   const std::int32_t* first = nullptr;
-  bool per_node = true;
   const std::int32_t* spring = nullptr;
   const std::int32_t* a = nullptr;
   const std::int32_t* b = nullptr;
   const double* k = nullptr;
-  int begin(int local, int node) const { return first[per_node ? node : local]; }
-  int end(int local, int node) const { return first[(per_node ? node : local) + 1]; }
+  int begin(int node) const { return first[node]; }
+  int end(int node) const { return first[node + 1]; }
   static NodeSprings of(const StepSprings& st) {
-    return {st.node_offset.data(), true, st.incident.data(), st.a.data(), st.b.data(), st.stiffness.data()};
+    return {st.node_offset.data(), st.incident.data(), st.a.data(), st.b.data(), st.stiffness.data()};
   }
+};
+
+// topEigenvalue's work arrays, kept by the caller across the estimates of one update: `local`
+// is all -1 between calls (reset on the way out).
+struct LanczosScratch {
+  std::vector<int> local;
+  std::vector<SpringY> springs;
+  std::vector<int> group;
+  std::vector<double> cols, y4, z4, inv_root;
 };
 
 // Top eigenvalue of M^-1/2 K M^-1/2 (springs linearised along their rest directions) over
@@ -289,18 +291,10 @@ struct NodeSprings {
 // return. Then that Ritz value is returned; the caller uses it only through `decided`.
 double topEigenvalue(const Model& m, const NodeSprings& st, const cutting::Positions& X, const std::vector<int>& nodes,
                      const Eigen::MatrixX3d* start, const CutUpdate3DOptions& options, Eigen::MatrixX3d* mode,
-                     int* steps_taken, const std::function<bool(double)>* decided) {
+                     int* steps_taken, const std::function<bool(double)>* decided, LanczosScratch& scratch) {
   const int count = static_cast<int>(nodes.size());
   if (steps_taken) *steps_taken = 0;
   if (count == 0) return 0.0;
-  // Scratch kept between calls (per thread): `local` is all -1 between calls (reset below).
-  struct Scratch {
-    std::vector<int> local;
-    std::vector<SpringY> springs;
-    std::vector<int> group;
-    std::vector<double> cols, y4, z4, inv_root;
-  };
-  thread_local Scratch scratch;
   std::vector<int>& local = scratch.local;
   if (local.size() < static_cast<size_t>(m.num_nodes)) local.resize(static_cast<size_t>(m.num_nodes), -1);
   for (int k = 0; k < count; ++k) local[nodes[k]] = k;
@@ -324,7 +318,7 @@ double topEigenvalue(const Model& m, const NodeSprings& st, const cutting::Posit
     const int node = nodes[k];
     group[k] = static_cast<int>(springs.size());
     double h[6] = {0, 0, 0, 0, 0, 0};  // xx yy zz xy yz zx
-    for (int e = st.begin(k, node), e_end = st.end(k, node); e < e_end; ++e) {
+    for (int e = st.begin(node), e_end = st.end(node); e < e_end; ++e) {
       const int s = st.spring[e];
       const int a = st.a[s], b = st.b[s];
       // (local is -1 at anchored nodes: `nodes` are free ones, the caller's estimate nodes.)
@@ -536,7 +530,7 @@ double topEigenvalueBound(const Model& m, const NodeSprings& st, const cutting::
   for (int i = 0; i < static_cast<int>(nodes.size()); ++i) {
     const int node = nodes[i];
     double s00 = 0, s11 = 0, s22 = 0, s01 = 0, s12 = 0, s20 = 0;
-    for (int e = st.begin(i, node), e_end = st.end(i, node); e < e_end; ++e) {
+    for (int e = st.begin(node), e_end = st.end(node); e < e_end; ++e) {
       const int s = st.spring[e];
       const int a = st.a[s], b = st.b[s];
       const double dx = X(b, 0) - X(a, 0), dy = X(b, 1) - X(a, 1), dz = X(b, 2) - X(a, 2);
@@ -564,14 +558,25 @@ double topEigenvalueBound(const Model& m, const NodeSprings& st, const cutting::
   return bound;
 }
 
-}  // namespace
+// What the first part of the update (prepareUpdate) hands to the second (finishUpdate).
+struct Prepared {
+  struct Spring {
+    int a, b;  // nodes of `after`
+    double rest, k, c;
+  };
+  CutUpdate3DReport report;            // filled so far: masses, touched_nodes, springs_recomputed, omega_previous
+  Eigen::VectorXd mass;                // #N of after
+  std::vector<std::uint8_t> touched;   // #N of after: masses and springs between them recomputed
+  std::vector<std::uint8_t> region;    // #N of after: touched and their rings (mass region)
+  std::vector<Spring> springs;         // recomputed, in buildModel's order
+};
 
-Status prepareModelAfterCut3D(const Model& model, const cutting::TetMesh& before, const cutting::TetMesh& after,
-                              const cutting::TopologyChange& change, const CutUpdate3DOptions& options,
-                              CutUpdate3DPrepared* prepared) {
+// The first part: the cut mesh's masses and the springs between touched nodes, which do not
+// depend on the nodes kept; the model is left as it is, so an error here changes nothing.
+Status prepareUpdate(const Model& model, const cutting::TetMesh& before, const cutting::TetMesh& after,
+                     const cutting::TopologyChange& change, const CutUpdate3DOptions& options, Prepared* prepared) {
   const auto start = std::chrono::steady_clock::now();
   const int N0 = before.numNodes(), N1 = after.numNodes(), T1 = after.numTets();
-  *prepared = CutUpdate3DPrepared{};
   if (model.num_nodes != N0 || model.mass.size() != N0) return Error{"updateModelAfterCut3D: the model is not the mesh's"};
   if (static_cast<int>(change.node_old_to_new.size()) != N0 || change.new_num_nodes != N1)
     return Error{"updateModelAfterCut3D: the change does not match the meshes"};
@@ -581,8 +586,6 @@ Status prepareModelAfterCut3D(const Model& model, const cutting::TetMesh& before
   const int T0 = before.numTets();
   if (static_cast<int>(change.element_old_to_new.size()) != T0)
     return Error{"updateModelAfterCut3D: the change's element map does not match the mesh"};
-  // The jobs handed to options.beside (cutting::LentJob: each declared after what its job
-  // uses, so it is waited for before any of that goes).
 
   // Touched nodes: their masses and the springs between them change.
   std::vector<std::uint8_t> touched(static_cast<size_t>(N1), 0);
@@ -591,15 +594,13 @@ Status prepareModelAfterCut3D(const Model& model, const cutting::TetMesh& before
   for (int i : change.cut_nodes)
     if (i >= 0 && i < N1) touched[i] = 1;
   // Elements that are not an old element with the same nodes (added, or renumbered onto a
-  // duplicate by the cut) touch their nodes, and so do the old elements they replace: found
-  // beside the node -> tets lists below (it reads the meshes and the change only, and writes
-  // `touched` and old_of, which nothing else reads until it is done).
+  // duplicate by the cut) touch their nodes, and so do the old elements they replace.
   const std::int32_t* after_col[4] = {after.T.col(0).data(), after.T.col(1).data(), after.T.col(2).data(),
                                        after.T.col(3).data()};
   const std::int32_t* before_col[4] = {before.T.col(0).data(), before.T.col(1).data(), before.T.col(2).data(),
                                         before.T.col(3).data()};
-  std::vector<int> old_of(static_cast<size_t>(T1), -1);
-  const std::function<void()> compareJob = [&] {
+  {
+    std::vector<int> old_of(static_cast<size_t>(T1), -1);
     for (int t = 0; t < T0; ++t) {
       const int u = change.element_old_to_new[t];
       if (u >= 0 && u < T1) old_of[u] = t;
@@ -647,8 +648,7 @@ Status prepareModelAfterCut3D(const Model& model, const cutting::TetMesh& before
     } else {
       for (int t = 0; t < T1; ++t) compareElement(t);
     }
-  };
-  cutting::LentJob compare(options.beside, compareJob);
+  }
 
   // Material of each tet (written in full below: allocated without a fill).
   const std::unique_ptr<int[]> material_storage(new int[static_cast<size_t>(T1)]);
@@ -709,7 +709,6 @@ Status prepareModelAfterCut3D(const Model& model, const cutting::TetMesh& before
     return volume[t];
   };
 
-  compare.join();
   auto touchTet = [&](int t) {
     for (int k = 0; k < 4; ++k) touched[node(t, k)] = 1;
   };
@@ -719,7 +718,6 @@ Status prepareModelAfterCut3D(const Model& model, const cutting::TetMesh& before
     if (i >= 0 && i < N1)
       for (int e = off[i]; e < off[i + 1]; ++e) touchTet(around[e]);  // their volumes changed
   std::vector<int> region_nodes;
-  region_nodes.reserve(static_cast<size_t>(N1));  // (never reallocated: see the springs below)
   for (int i = 0; i < N1; ++i)
     if (touched[i]) region_nodes.push_back(i);
   rep.touched_nodes = static_cast<int>(region_nodes.size());
@@ -727,96 +725,6 @@ Status prepareModelAfterCut3D(const Model& model, const cutting::TetMesh& before
     if (t >= 0 && t < T1 && !(tetVolume(t) > 0.0))
       return Error{"tet " + std::to_string(t) + " has non-positive volume " + std::to_string(tetVolume(t))};
   }
-  // Springs: unchanged unless both ends are touched; edges between touched nodes anew.
-  // The unchanged ones stay in the model's arrays (compacted in place by the second part,
-  // once nothing can fail); prepared->springs collects the recomputed ones, which follow them.
-  // Per touched node a in increasing order, the edges (a, b) to touched nodes b > a, in
-  // increasing b (buildModel's order), each summing its tets in increasing order (as
-  // buildModel does): a's tet list is in increasing order, so each b's sums are accumulated
-  // in that order, in a small table of a's neighbours (`slot`: b -> entry, -1 otherwise).
-  // The touched nodes go in chunks (kSpringChunk nodes each, taken in turn from `next_chunk`
-  // by whichever thread is free: the thread lent, from here on beside the rings and the
-  // masses, and this one once the masses are done), each into its own list; the lists in
-  // chunk order are the springs in the order of one pass. (Each thread has its own scratch:
-  // `slot` and `edge_sums`.)
-  struct EdgeSum {
-    int b;
-    double ev, bev;
-  };
-  struct SpringsScratch {
-    bool cached;  // volumes through the cache (this thread's scratch only)
-    std::vector<EdgeSum> edge_sums;
-    std::vector<int> slot;
-  };
-  constexpr int kSpringChunk = 64;
-  const int num_chunks = (rep.touched_nodes + kSpringChunk - 1) / kSpringChunk;
-  struct SpringChunk {
-    std::vector<CutUpdate3DPrepared::Spring> springs;
-    int bad_tet = -1;  // a tet of non-positive volume met (the chunk stopped there)
-    double bad_volume = 0.0;
-  };
-  std::vector<SpringChunk> chunks(static_cast<size_t>(num_chunks));
-  const int* const touched_list = region_nodes.data();
-  std::atomic<int> next_chunk{0};
-  // (Reads the touched nodes (the first entries of region_nodes, which the rings below only
-  // append to: room for every node is reserved, so they never move), the node -> tets lists,
-  // the materials and the positions; on the thread lent it computes its tets' volumes itself
-  // (the same arithmetic as the cached ones, which this thread writes meanwhile); writes only
-  // its own chunks and scratch.)
-  auto springChunks = [&](SpringsScratch& scratch) {
-    std::vector<EdgeSum>& edge_sums = scratch.edge_sums;
-    std::vector<int>& slot = scratch.slot;
-    for (int c = next_chunk.fetch_add(1, std::memory_order_relaxed); c < num_chunks;
-         c = next_chunk.fetch_add(1, std::memory_order_relaxed)) {
-      if (slot.empty()) slot.assign(static_cast<size_t>(N1), -1);
-      SpringChunk& chunk = chunks[c];
-      // About 7 edges a node towards higher-numbered neighbours in a tet mesh.
-      chunk.springs.reserve(8 * kSpringChunk);
-      const int r_end = std::min(rep.touched_nodes, (c + 1) * kSpringChunk);
-      for (int r = c * kSpringChunk; r < r_end && chunk.bad_tet < 0; ++r) {
-        const int a = touched_list[r];
-        edge_sums.clear();
-        for (int e = off[a]; e < off[a + 1] && chunk.bad_tet < 0; ++e) {
-          const int t = around[e];
-          const Material* mat = nullptr;
-          double vol = 0.0;
-          for (int k = 0; k < 4; ++k) {
-            const int b = node(t, k);
-            if (b <= a || !touched[b]) continue;
-            if (mat == nullptr) {
-              vol = scratch.cached ? tetVolume(t) : computeVolume(t);
-              if (!(vol > 0.0)) {
-                chunk.bad_tet = t;
-                chunk.bad_volume = vol;
-                break;
-              }
-              mat = &model.materials[material[t]];
-            }
-            int& at = slot[b];
-            if (at < 0) {
-              at = static_cast<int>(edge_sums.size());
-              edge_sums.push_back({b, 0.0, 0.0});
-            }
-            EdgeSum& sum = edge_sums[at];
-            sum.ev += mat->young_modulus_pa * vol;
-            sum.bev += mat->stiffness_damping_s * mat->young_modulus_pa * vol;
-          }
-        }
-        for (const EdgeSum& sum : edge_sums) slot[sum.b] = -1;
-        if (chunk.bad_tet >= 0) break;
-        std::sort(edge_sums.begin(), edge_sums.end(), [](const EdgeSum& x, const EdgeSum& y) { return x.b < y.b; });
-        for (const EdgeSum& sum : edge_sums) {
-          const double len = (after.X.row(sum.b) - after.X.row(a)).norm();
-          chunk.springs.push_back({a, sum.b, len, sum.ev / (len * len), sum.bev / (len * len)});
-        }
-      }
-    }
-  };
-  // (Without a thread lent, this thread takes every chunk once the masses are done, as
-  // before, reading the volumes the lumped priors cached.)
-  SpringsScratch lent_scratch{false, {}, {}}, own_scratch{true, {}, {}};
-  const std::function<void()> springsJob = [&] { springChunks(lent_scratch); };
-  cutting::LentJob springs_lent(options.beside, options.beside ? springsJob : [] {});
   // Mass region: the touched nodes and rings of neighbours (a cut's nodes lie near one
   // surface, where the second moments across it are badly conditioned).
   std::vector<std::uint8_t> region = touched;
@@ -890,25 +798,57 @@ Status prepareModelAfterCut3D(const Model& model, const cutting::TetMesh& before
     rep.masses.clamped = clamped;
     rep.masses.moment_residual = res.cwiseAbs().maxCoeff() / std::max(target.cwiseAbs().maxCoeff(), 1e-300);
   }
-  bool masses_ok = true;
-  for (int j : region_nodes) masses_ok = masses_ok && mass[j] >= 0.0 && std::isfinite(mass[j]);
-  springChunks(own_scratch);  // the chunks the lent thread has not taken yet
-  springs_lent.join();
-  if (!masses_ok) return Error{"updateModelAfterCut3D: non-finite or negative mass"};
-  // The chunks in order: the first tet of non-positive volume a single pass would meet, or
-  // the springs in that pass's order.
-  size_t recomputed = 0;
-  for (const SpringChunk& chunk : chunks) {
-    if (chunk.bad_tet >= 0)
-      return Error{"tet " + std::to_string(chunk.bad_tet) + " has non-positive volume " +
-                   std::to_string(chunk.bad_volume)};
-    recomputed += chunk.springs.size();
+  for (int j : region_nodes)
+    if (!(mass[j] >= 0.0 && std::isfinite(mass[j]))) return Error{"updateModelAfterCut3D: non-finite or negative mass"};
+  // Springs: unchanged unless both ends are touched; edges between touched nodes anew.
+  // The unchanged ones stay in the model's arrays (compacted in place by the second part,
+  // once nothing can fail); prepared->springs collects the recomputed ones, which follow them.
+  // Per touched node a in increasing order (the first entries of region_nodes), the edges
+  // (a, b) to touched nodes b > a, in increasing b (buildModel's order), each summing its
+  // tets in increasing order (as buildModel does): a's tet list is in increasing order, so
+  // each b's sums are accumulated in that order, in a small table of a's neighbours (`slot`:
+  // b -> entry, -1 otherwise).
+  struct EdgeSum {
+    int b;
+    double ev, bev;
+  };
+  std::vector<EdgeSum> edge_sums;
+  std::vector<int> slot(static_cast<size_t>(N1), -1);
+  std::vector<Prepared::Spring>& springs = prepared->springs;
+  springs.reserve(8 * static_cast<size_t>(rep.touched_nodes));  // about 7 edges a node towards higher-numbered ones
+  for (int r = 0; r < rep.touched_nodes; ++r) {
+    const int a = region_nodes[r];
+    edge_sums.clear();
+    for (int e = off[a]; e < off[a + 1]; ++e) {
+      const int t = around[e];
+      const Material* mat = nullptr;
+      double vol = 0.0;
+      for (int k = 0; k < 4; ++k) {
+        const int b = node(t, k);
+        if (b <= a || !touched[b]) continue;
+        if (mat == nullptr) {
+          vol = tetVolume(t);
+          if (!(vol > 0.0)) return Error{"tet " + std::to_string(t) + " has non-positive volume " + std::to_string(vol)};
+          mat = &model.materials[material[t]];
+        }
+        int& at = slot[b];
+        if (at < 0) {
+          at = static_cast<int>(edge_sums.size());
+          edge_sums.push_back({b, 0.0, 0.0});
+        }
+        EdgeSum& sum = edge_sums[at];
+        sum.ev += mat->young_modulus_pa * vol;
+        sum.bev += mat->stiffness_damping_s * mat->young_modulus_pa * vol;
+      }
+    }
+    for (const EdgeSum& sum : edge_sums) slot[sum.b] = -1;
+    std::sort(edge_sums.begin(), edge_sums.end(), [](const EdgeSum& x, const EdgeSum& y) { return x.b < y.b; });
+    for (const EdgeSum& sum : edge_sums) {
+      const double len = (after.X.row(sum.b) - after.X.row(a)).norm();
+      springs.push_back({a, sum.b, len, sum.ev / (len * len), sum.bev / (len * len)});
+    }
   }
-  std::vector<CutUpdate3DPrepared::Spring>& springs = prepared->springs;
-  springs.reserve(recomputed);
-  for (const SpringChunk& chunk : chunks) springs.insert(springs.end(), chunk.springs.begin(), chunk.springs.end());
-  rep.springs_recomputed = static_cast<int>(recomputed);
-  prepared->num_nodes_before = N0;
+  rep.springs_recomputed = static_cast<int>(springs.size());
   prepared->mass = std::move(mass);
   prepared->touched = std::move(touched);
   prepared->region = std::move(region);
@@ -916,14 +856,12 @@ Status prepareModelAfterCut3D(const Model& model, const cutting::TetMesh& before
   return Status::Ok();
 }
 
-Status finishModelAfterCut3D(Model& model, const cutting::TetMesh& after, const cutting::TopologyChange& change,
-                             const std::vector<std::uint8_t>& fixed_after, const std::vector<std::int32_t>& node_to_kept,
-                             const CutUpdate3DOptions& options, CutUpdate3DPrepared& prepared,
-                             CutUpdate3DReport* report) {
-  const int N0 = prepared.num_nodes_before, N1 = after.numNodes();
-  if (N0 < 0 || model.num_nodes != N0 || static_cast<int>(change.node_old_to_new.size()) != N0 ||
-      change.new_num_nodes != N1 || prepared.mass.size() != N1)
-    return Error{"updateModelAfterCut3D: the first part was not run for this model and cut"};
+// The second part: drops the pieces cut free, renumbers, updates the model in place and
+// estimates its stability.
+Status finishUpdate(Model& model, const cutting::TetMesh& after, const cutting::TopologyChange& change,
+                    const std::vector<std::uint8_t>& fixed_after, const std::vector<std::int32_t>& node_to_kept,
+                    const CutUpdate3DOptions& options, Prepared& prepared, CutUpdate3DReport* report) {
+  const int N0 = model.num_nodes, N1 = after.numNodes();
   if (static_cast<int>(fixed_after.size()) != N1) return Error{"updateModelAfterCut3D: fixed flags size differs from #N"};
   if (!node_to_kept.empty() && static_cast<int>(node_to_kept.size()) != N1)
     return Error{"updateModelAfterCut3D: node_to_kept size differs from #N"};
@@ -932,7 +870,7 @@ Status finishModelAfterCut3D(Model& model, const cutting::TetMesh& after, const 
   const Eigen::VectorXd& mass = prepared.mass;
   const std::vector<std::uint8_t>& touched = prepared.touched;
   const std::vector<std::uint8_t>& region = prepared.region;
-  const std::vector<CutUpdate3DPrepared::Spring>& springs = prepared.springs;
+  const std::vector<Prepared::Spring>& springs = prepared.springs;
 
   // Pieces cut free leave; the rest is renumbered (order kept).
   std::vector<std::int32_t> keep(node_to_kept);
@@ -1021,13 +959,13 @@ Status finishModelAfterCut3D(Model& model, const cutting::TetMesh& after, const 
     }
   }
   Eigen::Index ns = out;
-  for (const CutUpdate3DPrepared::Spring& s : springs) ns += (keep[s.a] >= 0 && keep[s.b] >= 0) ? 1 : 0;
+  for (const Prepared::Spring& s : springs) ns += (keep[s.a] >= 0 && keep[s.b] >= 0) ? 1 : 0;
   m.springs.conservativeResize(ns, 2);
   m.rest_length.conservativeResize(ns);
   m.stiffness.conservativeResize(ns);
   m.damping.conservativeResize(ns);
   for (int s = 0; s < static_cast<int>(springs.size()); ++s) {
-    const CutUpdate3DPrepared::Spring& sp = springs[s];
+    const Prepared::Spring& sp = springs[s];
     if (keep[sp.a] < 0 || keep[sp.b] < 0) continue;
     m.springs(out, 0) = keep[sp.a];
     m.springs(out, 1) = keep[sp.b];
@@ -1037,49 +975,8 @@ Status finishModelAfterCut3D(Model& model, const cutting::TetMesh& after, const 
     ++out;
     countStep(keep[sp.a], keep[sp.b]);
   }
-  // The step's arrays (fillStepSprings), and the springs at the estimate's nodes as the
-  // estimate reads them. With a thread lent, that thread fills the step's arrays while this
-  // one estimates; the estimate then reads the springs (m.springs, which neither thread writes
-  // any more) through lists of its own nodes, built there first: each node's springs in
-  // increasing order, as the step's lists have them, so its sums are the same to the last bit.
-  // (Their sizes are the step degrees counted above; `local` is -1 between calls.)
-  struct EstimateLists {
-    std::vector<std::int32_t> first, cursor, spring, local;
-  };
-  thread_local EstimateLists lists;
-  ResetLocal reset_local{lists.local, estimate_nodes, false};  // (after the jobs below, which read `local`)
-  NodeSprings node_springs;
-  std::optional<cutting::LentJob> lists_job, fill_job;
-  if (options.beside) {
-    const int count = static_cast<int>(estimate_nodes.size());
-    if (lists.local.size() < static_cast<size_t>(N2)) lists.local.resize(static_cast<size_t>(N2), -1);
-    lists.first.resize(static_cast<size_t>(count) + 1);
-    lists.first[0] = 0;
-    for (int k = 0; k < count; ++k) {
-      lists.local[estimate_nodes[k]] = k;
-      lists.first[k + 1] = lists.first[k] + step_degree[estimate_nodes[k]];
-    }
-    reset_local.armed = true;
-    lists.cursor.assign(lists.first.begin(), lists.first.end() - 1);
-    lists.spring.resize(static_cast<size_t>(lists.first[count]));
-    const std::int32_t* const sa = m.springs.col(0).data();
-    const std::int32_t* const sb = m.springs.col(1).data();
-    const Eigen::Index rows = m.springs.rows();
-    // (The pointers are taken here: `lists` named on the other thread would be its own.)
-    lists_job.emplace(options.beside, [sa, sb, rows, local = lists.local.data(), cursor = lists.cursor.data(),
-                                       spring = lists.spring.data()] {
-      for (Eigen::Index s = 0; s < rows; ++s) {
-        const std::int32_t la = local[sa[s]], lb = local[sb[s]];
-        if (la >= 0) spring[cursor[la]++] = static_cast<std::int32_t>(s);
-        if (lb >= 0) spring[cursor[lb]++] = static_cast<std::int32_t>(s);
-      }
-    });
-    fill_job.emplace(options.beside, [&m, step_count] { fillStepSprings(m, step_count); });
-    node_springs = {lists.first.data(), false, lists.spring.data(), sa, sb, m.stiffness.data()};
-  } else {
-    fillStepSprings(m, step_count);
-    node_springs = NodeSprings::of(m.step_springs);
-  }
+  fillStepSprings(m, step_count);
+  const NodeSprings node_springs = NodeSprings::of(m.step_springs);
   rep.springs_ms = msSince(springs_start);
   cutting::Positions X(N2, 3);
   for (int i = 0; i < N1; ++i)
@@ -1123,6 +1020,7 @@ Status finishModelAfterCut3D(Model& model, const cutting::TetMesh& after, const 
     if (!rep.global_stability && !(omega >= rep.omega_previous)) return false;  // carried
     return substepsFor(stabilityLimit(omega)) > opt.max_substeps;
   };
+  LanczosScratch lanczos;
   auto estimate = [&](bool round_may_follow) {
     if (!rep.global_stability) {
       // Near the cut, an upper bound below the previous estimate settles what a Lanczos
@@ -1138,7 +1036,7 @@ Status finishModelAfterCut3D(Model& model, const cutting::TetMesh& after, const 
     int steps = 0;
     const bool stop_early = options.stop_decided_estimates && may_scale && round_may_follow;
     const double lambda = topEigenvalue(m, node_springs, X, estimate_nodes, rep.global_stability ? &mapped_mode : nullptr, options,
-                                        &ritz, &steps, stop_early ? &scaling_follows : nullptr);
+                                        &ritz, &steps, stop_early ? &scaling_follows : nullptr, lanczos);
     rep.lanczos_steps += steps;
     rep.omega_local = std::sqrt(lambda);
     if (rep.global_stability || rep.omega_local >= rep.omega_previous) {
@@ -1155,15 +1053,7 @@ Status finishModelAfterCut3D(Model& model, const cutting::TetMesh& after, const 
     }
   };
   const auto stability_start = std::chrono::steady_clock::now();
-  if (lists_job) lists_job->join();
   estimate(true);
-  double stability_ms = msSince(stability_start);
-  if (fill_job) {  // (the rounds below and the implicit solver read the step's arrays)
-    const auto wait_start = std::chrono::steady_clock::now();
-    fill_job->join();
-    rep.springs_ms += msSince(wait_start);
-  }
-  const auto rounds_start = std::chrono::steady_clock::now();
   // Selective mass scaling, as buildModel, on the nodes of the estimate.
   // A carried-over previous estimate is not lowered by mass near the cut: no rounds then.
   if (opt.substeps <= 0 && opt.max_substeps > 0 && substepsFor(m.critical_dt) > opt.max_substeps && !carried) {
@@ -1184,7 +1074,7 @@ Status finishModelAfterCut3D(Model& model, const cutting::TetMesh& after, const 
       target *= 0.7;
     }
   }
-  rep.stability_ms = stability_ms + msSince(rounds_start);
+  rep.stability_ms = msSince(stability_start);
   m.substeps = opt.substeps > 0 ? opt.substeps : substepsFor(m.critical_dt);
   if (opt.substeps <= 0 && opt.max_substeps > 0) m.substeps = std::min(m.substeps, opt.max_substeps);
   m.substep = opt.dt / m.substeps;
@@ -1198,14 +1088,16 @@ Status finishModelAfterCut3D(Model& model, const cutting::TetMesh& after, const 
   return Status::Ok();
 }
 
+}  // namespace
+
 Status updateModelAfterCut3D(Model& model, const cutting::TetMesh& before, const cutting::TetMesh& after,
                              const cutting::TopologyChange& change, const std::vector<std::uint8_t>& fixed_after,
                              const std::vector<std::int32_t>& node_to_kept, const CutUpdate3DOptions& options,
                              CutUpdate3DReport* report) {
-  CutUpdate3DPrepared prepared;  // (the first part leaves the model as it is)
-  const Status first = prepareModelAfterCut3D(model, before, after, change, options, &prepared);
+  Prepared prepared;  // (the first part leaves the model as it is)
+  const Status first = prepareUpdate(model, before, after, change, options, &prepared);
   if (!first.ok()) return first;
-  return finishModelAfterCut3D(model, after, change, fixed_after, node_to_kept, options, prepared, report);
+  return finishUpdate(model, after, change, fixed_after, node_to_kept, options, prepared, report);
 }
 
 }  // namespace hysim::sim

@@ -14,9 +14,10 @@ struct Output {
   std::string text;  // stdout and stderr
 };
 
-inline Output runHysim(const std::string& args) {
+// `prefix` runs before the binary (e.g. "taskset -c 0").
+inline Output runHysim(const std::string& args, const std::string& prefix = "") {
   Output out;
-  const std::string cmd = std::string("cd ") + HYSIM_SOURCE_DIR + " && " + HYSIM_BINARY + " " + args + " 2>&1";
+  const std::string cmd = std::string("cd ") + HYSIM_SOURCE_DIR + " && " + prefix + " " + HYSIM_BINARY + " " + args + " 2>&1";
   FILE* pipe = popen(cmd.c_str(), "r");
   if (pipe == nullptr) return out;
   std::array<char, 4096> buf;

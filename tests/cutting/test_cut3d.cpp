@@ -9,10 +9,8 @@
 #include <filesystem>
 #include <limits>
 #include <random>
-#include <thread>
 
 #include "box_mesh.hpp"
-#include "thread_beside.hpp"
 #include "hysim/cutting/cut3d.hpp"
 #include "hysim/cutting/mesh_io.hpp"
 #include "hysim/cutting/mesh_stats.hpp"
@@ -539,13 +537,10 @@ TEST(Cut3D, BadInput) {
   EXPECT_FALSE(cut3d(bad, *CutSurface::plane(Vec3(0, 0, 0), Vec3(0, 0, 1))).ok());
 }
 
-// CutSurface::strip is the surface triangles() makes of the same grid (same triangle
-// numbers), only with a tree that follows the grid: every query answers the same, bit for
-// bit, and cut3d cuts the same. The strip: a half-cylinder loop swept along a bent path,
-// with a collapsed quad (degenerate triangles, dropped by both).
-// Work handed to options.beside (run on another thread here) gives the same cut to the last
-// bit as the same work on the calling thread, also for a cut that is refused.
-TEST(Cut3D, WorkBesideGivesTheSameCut) {
+// The same cut twice gives the same result to the last bit (no state carries over from one
+// cut to the next, no uninitialised scratch is read), also for a cut that is refused. A
+// curved strip through a box, every move list that can be split split in two parts.
+TEST(Cut3D, TheSameCutTwiceGivesTheSameResult) {
   const TetMesh box = testing::boxTetMesh(6, 6, 6, 1.0);
   const int rows = 9, row_size = 7;
   Positions X(rows * row_size, 3);
@@ -556,32 +551,29 @@ TEST(Cut3D, WorkBesideGivesTheSameCut) {
     }
   const auto surface = CutSurface::strip(X, rows, row_size);
   ASSERT_TRUE(surface.ok());
-  Cut3DOptions here;
-  here.method = CutMethod::Hybrid;
-  here.optimize.parallel_min_nodes = 2;  // (every move list that splits does)
-  Cut3DOptions beside = here;
-  testing::ThreadBeside threads;
-  beside.beside = threads.lend();
-  const auto a = cut3d(box, *surface, here);
-  const auto b = cut3d(box, *surface, beside);
+  Cut3DOptions options;
+  options.method = CutMethod::Hybrid;
+  options.optimize.parallel_min_nodes = 2;
+  const auto a = cut3d(box, *surface, options);
+  const auto b = cut3d(box, *surface, options);
   ASSERT_TRUE(a.ok() && b.ok()) << (a.ok() ? b.error() : a.error());
-  // The node -> tets lists, the mesh's volume for the optimisation, and half of the move
-  // iterations' nodes (at least once).
-  EXPECT_GE(threads.jobs(), 3);
-  const int cutJobs = threads.jobs();
   EXPECT_GT(a->report.cut_faces, 0);
+  EXPECT_GT(a->report.optimize_iterations, 0);
   EXPECT_TRUE(a->mesh.X == b->mesh.X);
   EXPECT_TRUE(a->mesh.T == b->mesh.T);
+  EXPECT_TRUE(a->mesh.material == b->mesh.material);
   EXPECT_EQ(a->change.node_old_to_new, b->change.node_old_to_new);
   EXPECT_EQ(a->change.element_old_to_new, b->change.element_old_to_new);
-  // Refused after the job started (a mesh whose nodes all coincide): the job is waited for
-  // before the error returns.
+  EXPECT_EQ(a->change.added_elements, b->change.added_elements);
+  EXPECT_EQ(a->change.moved_nodes, b->change.moved_nodes);
+  EXPECT_EQ(a->change.cut_faces, b->change.cut_faces);
+  // Refused (a mesh whose nodes all coincide): the same error both times.
   TetMesh flat = box;
   flat.X.setZero();
-  const auto refused = cut3d(flat, *surface, beside);
-  EXPECT_FALSE(refused.ok());
-  EXPECT_EQ(threads.jobs(), cutJobs + 1);
-  for (std::thread& t : threads.threads) EXPECT_FALSE(t.joinable());
+  const auto refused = cut3d(flat, *surface, options), again = cut3d(flat, *surface, options);
+  ASSERT_FALSE(refused.ok());
+  ASSERT_FALSE(again.ok());
+  EXPECT_EQ(refused.error(), again.error());
 }
 
 // The report's step times: non-negative; the cut's steps are the time up to cut_ms, the
@@ -611,6 +603,10 @@ TEST(Cut3D, ReportStepTimesAddUp) {
   EXPECT_GT(s->report.classify_ms + s->report.subdivide_ms, 0.0);
 }
 
+// CutSurface::strip is the surface triangles() makes of the same grid (same triangle
+// numbers), only with a tree that follows the grid: every query answers the same, bit for
+// bit, and cut3d cuts the same. The strip: a half-cylinder loop swept along a bent path,
+// with a collapsed quad (degenerate triangles, dropped by both).
 TEST(Cut3D, StripIsTheSameSurfaceAsItsTriangles) {
   const int rows = 23, row_size = 13;
   Positions X(rows * row_size, 3);
@@ -974,7 +970,7 @@ TEST(Cut3D, SurfaceWalksMatchBruteForce) {
         }
         for (double r : {std::abs(dRef), std::abs(dRef) * (1 - 1e-9), std::abs(dRef) * (1 + 1e-9), 1e-3, 0.05})
           EXPECT_EQ(s->within(x, r), within(x, r)) << strip << " " << i << " r " << r;
-        // A segment from x to a point across the surface (and one beside it).
+        // A segment from x to a point across the surface (and one next to it).
         for (const Vec3& y : {Vec3(pRef + (pRef - x) + 0.01 * n), Vec3(x + 0.3 * (b - a))}) {
           double tRef;
           const bool fRef = crossing(x, y, 1e-9, &tRef);

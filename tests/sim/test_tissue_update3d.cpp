@@ -8,7 +8,6 @@
 #include <random>
 
 #include "box_mesh.hpp"
-#include "thread_beside.hpp"
 #include "hysim/cutting/cut3d.hpp"
 #include "hysim/sim/tissue_update3d.hpp"
 #include "../../sim/src/model_internal.hpp"  // topTridiagonalEigenvalue
@@ -315,9 +314,10 @@ TEST(TissueUpdate3D, IncrementalUpdateAfterAPartialCut) {
   EXPECT_NEAR(model.mass.sum(), built->mass.sum(), 1e-9 * built->mass.sum());
 }
 
-// The update in two parts (prepare while the pieces are searched, then finish with the kept
-// nodes) is the one-call update to the last bit; finish refuses a first part of another model.
-TEST(TissueUpdate3D, TwoPartUpdateIsTheOneCallUpdate) {
+// An update that drops the pieces cut free (node_to_kept) reports its steps' wall times; the
+// same update of another copy gives the same model to the last bit; an update that is
+// refused (fixed flags of the wrong size) leaves the model as it was.
+TEST(TissueUpdate3D, UpdateDroppingPiecesIsRepeatableAndRefusedLeavesTheModel) {
   const cutting::TetMesh mesh = testing::boxTetMesh(6, 6, 6, 1.0);
   auto built = modelHeldBelowHalf(mesh);
   ASSERT_TRUE(built.ok());
@@ -340,42 +340,31 @@ TEST(TissueUpdate3D, TwoPartUpdateIsTheOneCallUpdate) {
   Model one = *built, two = *built;
   CutUpdate3DReport rep_one, rep_two;
   ASSERT_TRUE(updateModelAfterCut3D(one, mesh, r->mesh, r->change, fixed, keep, {}, &rep_one).ok());
-  CutUpdate3DPrepared prepared;
-  ASSERT_TRUE(prepareModelAfterCut3D(two, mesh, r->mesh, r->change, {}, &prepared).ok());
-  ASSERT_TRUE(finishModelAfterCut3D(two, r->mesh, r->change, fixed, keep, {}, prepared, &rep_two).ok());
+  ASSERT_TRUE(updateModelAfterCut3D(two, mesh, r->mesh, r->change, fixed, keep, {}, &rep_two).ok());
   EXPECT_LT(one.num_nodes, n);
   expectSameModel(one, two);
   EXPECT_EQ(rep_one.lanczos_steps, rep_two.lanczos_steps);
   EXPECT_EQ(rep_one.touched_nodes, rep_two.touched_nodes);
-  // The steps' wall times are reported (the first part's kept through the second).
-  EXPECT_GT(rep_two.prepare_ms, 0.0);
-  EXPECT_GT(rep_two.springs_ms, 0.0);
-  EXPECT_GT(rep_two.stability_ms, 0.0);
-  // A first part for another model (the cut one) is refused, and the model is left as it was.
-  Model other = *built;
-  CutUpdate3DPrepared stale;
-  ASSERT_TRUE(prepareModelAfterCut3D(other, mesh, r->mesh, r->change, {}, &stale).ok());
-  Model cut_model = one;
-  const Status refused = finishModelAfterCut3D(cut_model, r->mesh, r->change, fixed, keep, {}, stale);
+  EXPECT_GT(rep_one.prepare_ms, 0.0);
+  EXPECT_GT(rep_one.springs_ms, 0.0);
+  EXPECT_GT(rep_one.stability_ms, 0.0);
+  Model refused_model = *built;
+  const std::vector<std::uint8_t> short_flags(static_cast<size_t>(n - 1), 0);
+  const Status refused = updateModelAfterCut3D(refused_model, mesh, r->mesh, r->change, short_flags, keep);
   EXPECT_FALSE(refused.ok());
-  EXPECT_NE(refused.error().find("first part"), std::string::npos) << refused.error();
-  EXPECT_EQ(cut_model.num_nodes, one.num_nodes);
-  EXPECT_TRUE(cut_model.mass == one.mass);
+  EXPECT_NE(refused.error().find("fixed flags"), std::string::npos) << refused.error();
+  EXPECT_EQ(refused_model.num_nodes, built->num_nodes);
+  EXPECT_TRUE(refused_model.mass == built->mass);
+  EXPECT_TRUE(refused_model.springs == built->springs);
 }
 
-// The first part with a thread lent (CutUpdate3DOptions::beside: the element comparison and
-// the springs on it) gives the same model to the last bit, for the SIMD and the baseline
-// forms, after complete cuts (in the larger box the touched nodes' springs make many chunks,
-// which both threads take) and after partial cuts (a small one in a larger box, whose masses
-// sum over the touched nodes' tets rather than over all tets); every job it lends is waited
-// for, also when it fails (with only the comparison lent, and with the springs lent; a tet of
-// non-positive volume in several chunks: the error names the one a single pass meets first).
-// The second part with a thread lent (the step's spring arrays filled there while this thread
-// estimates the stable step from lists of its own) gives the same model and step arrays too,
-// also where rounds of mass scaling follow (max_substeps 1), which read the step's arrays.
-// Data races between the two threads are for ThreadSanitizer to find; here they would show as
-// a different model.
-TEST(TissueUpdate3D, WorkBesideGivesTheSameModel) {
+// The same update twice gives the same model to the last bit (no state carries over from
+// one update to the next), for the SIMD and the baseline forms, after complete cuts and
+// after partial cuts (a small one in a larger box, whose masses sum over the touched nodes'
+// tets rather than over all tets), also where rounds of mass scaling follow (max_substeps
+// 1). Updates that fail (an unknown material, masses that cannot be kept, tets of
+// non-positive volume) name the cause and leave the model as it was.
+TEST(TissueUpdate3D, TheSameUpdateTwiceGivesTheSameModel) {
   const cutting::TetMesh box6 = testing::boxTetMesh(6, 6, 6, 1.0);
   const cutting::TetMesh box12 = testing::boxTetMesh(12, 12, 12, 1.0);
   Material mat;
@@ -409,105 +398,57 @@ TEST(TissueUpdate3D, WorkBesideGivesTheSameModel) {
       model_options.max_substeps = max_substeps;
       auto built = buildModel(mesh, {mat}, fixed, model_options);
       ASSERT_TRUE(built.ok());
-      Model alone = *built, beside = *built;
-      CutUpdate3DPrepared pa, pb;
-      ASSERT_TRUE(prepareModelAfterCut3D(alone, mesh, r->mesh, r->change, {}, &pa).ok());
-      testing::ThreadBeside threads;
-      CutUpdate3DOptions options;
-      options.beside = threads.lend();
-      ASSERT_TRUE(prepareModelAfterCut3D(beside, mesh, r->mesh, r->change, options, &pb).ok());
-      EXPECT_EQ(threads.jobs(), 2);
-      for (const std::thread& t : threads.threads) EXPECT_FALSE(t.joinable());  // waited for
-      EXPECT_TRUE(pa.mass == pb.mass);
-      EXPECT_TRUE(pa.touched == pb.touched);
-      EXPECT_TRUE(pa.region == pb.region);
-      ASSERT_EQ(pa.springs.size(), pb.springs.size());
-      EXPECT_EQ(0, std::memcmp(pa.springs.data(), pb.springs.data(), pa.springs.size() * sizeof(pa.springs[0])));
-      EXPECT_EQ(pa.report.touched_nodes, pb.report.touched_nodes);
-      EXPECT_EQ(pa.report.springs_recomputed, pb.report.springs_recomputed);
-      EXPECT_GT(pa.report.springs_recomputed, 0);
-      EXPECT_LT(pa.report.touched_nodes, r->mesh.numNodes());
-      if (mesh_ptr == &box12 && surface == &complete) {
-        EXPECT_GT(pa.report.touched_nodes, 4 * 64);  // (the springs' chunks are 64 nodes)
-      }
+      Model first = *built, second = *built;
       CutUpdate3DReport ra, rb;
-      const double added_before = alone.added_mass;
-      ASSERT_TRUE(finishModelAfterCut3D(alone, r->mesh, r->change, flags, {}, {}, pa, &ra).ok());
-      testing::ThreadBeside finish_threads;
-      CutUpdate3DOptions finish_options;
-      finish_options.beside = finish_threads.lend();
-      ASSERT_TRUE(finishModelAfterCut3D(beside, r->mesh, r->change, flags, {}, finish_options, pb, &rb).ok());
-      EXPECT_EQ(finish_threads.jobs(), 2);
-      for (const std::thread& t : finish_threads.threads) EXPECT_FALSE(t.joinable());  // waited for
-      expectSameModel(alone, beside);
-      EXPECT_TRUE(alone.inv_mass == beside.inv_mass);
-      EXPECT_EQ(alone.added_mass, beside.added_mass);
+      ASSERT_TRUE(updateModelAfterCut3D(first, mesh, r->mesh, r->change, flags, {}, {}, &ra).ok());
+      ASSERT_TRUE(updateModelAfterCut3D(second, mesh, r->mesh, r->change, flags, {}, {}, &rb).ok());
+      expectSameModel(first, second);
+      EXPECT_TRUE(first.inv_mass == second.inv_mass);
+      EXPECT_EQ(first.added_mass, second.added_mass);
       if (max_substeps == 1 && surface != &small) {  // (after the small cut the previous estimate is carried)
-        EXPECT_GT(alone.added_mass, added_before);     // rounds of mass scaling ran
+        EXPECT_GT(first.added_mass, built->added_mass);  // rounds of mass scaling ran
       }
-      const StepSprings &sa = alone.step_springs, &sb = beside.step_springs;
+      const StepSprings &sa = first.step_springs, &sb = second.step_springs;
       EXPECT_TRUE(sa.a == sb.a && sa.b == sb.b && sa.node_offset == sb.node_offset && sa.incident == sb.incident);
       EXPECT_TRUE(sa.rest_length == sb.rest_length && sa.stiffness == sb.stiffness && sa.damping == sb.damping &&
                   sa.sign == sb.sign);
+      EXPECT_GT(ra.springs_recomputed, 0);
+      EXPECT_LT(ra.touched_nodes, r->mesh.numNodes());
+      EXPECT_EQ(ra.touched_nodes, rb.touched_nodes);
+      EXPECT_EQ(ra.springs_recomputed, rb.springs_recomputed);
       EXPECT_EQ(ra.lanczos_steps, rb.lanczos_steps);
       EXPECT_EQ(ra.global_stability, rb.global_stability);
     }
     auto built = buildModel(mesh, {mat}, fixed, {});
     ASSERT_TRUE(built.ok());
-    {
-      // A material the model does not know: the same error, after the job lent first (the
-      // element comparison) was waited for.
-      cutting::TetMesh unknown = r->mesh;
-      unknown.material[unknown.numTets() / 2] = 7;
-      testing::ThreadBeside threads;
-      CutUpdate3DOptions options;
-      options.beside = threads.lend();
-      CutUpdate3DPrepared failed;
-      const Status st = prepareModelAfterCut3D(*built, mesh, unknown, r->change, options, &failed);
+    auto expectRefused = [&](const cutting::TetMesh& after, Model model, const std::string& cause) {
+      const Eigen::VectorXd mass = model.mass;
+      const Status st = updateModelAfterCut3D(model, mesh, after, r->change, flags, {});
       ASSERT_FALSE(st.ok());
-      EXPECT_NE(st.error().find("material label 7"), std::string::npos) << st.error();
-      EXPECT_EQ(threads.jobs(), 1);
-      for (const std::thread& t : threads.threads) EXPECT_FALSE(t.joinable());
+      EXPECT_NE(st.error().find(cause), std::string::npos) << st.error();
+      EXPECT_EQ(model.num_nodes, mesh.numNodes());
+      ASSERT_EQ(model.mass.size(), mass.size());
+      EXPECT_EQ(0, std::memcmp(model.mass.data(), mass.data(), sizeof(double) * mass.size()));  // (NaN too)
+    };
+    {
+      cutting::TetMesh unknown = r->mesh;  // a material the model does not know
+      unknown.material[unknown.numTets() / 2] = 7;
+      expectRefused(unknown, *built, "material label 7");
     }
     {
-      // Masses that cannot be kept (the old ones not finite): the error once the springs lent
-      // beside the masses were waited for, and no springs left in the first part.
-      Model broken = *built;
+      Model broken = *built;  // masses that cannot be kept (the old ones not finite)
       broken.mass.setConstant(std::numeric_limits<double>::quiet_NaN());
-      testing::ThreadBeside threads;
-      CutUpdate3DOptions options;
-      options.beside = threads.lend();
-      CutUpdate3DPrepared failed;
-      const Status st = prepareModelAfterCut3D(broken, mesh, r->mesh, r->change, options, &failed);
-      ASSERT_FALSE(st.ok());
-      EXPECT_NE(st.error().find("non-finite or negative mass"), std::string::npos) << st.error();
-      EXPECT_EQ(threads.jobs(), 2);
-      for (const std::thread& t : threads.threads) EXPECT_FALSE(t.joinable());
-      EXPECT_TRUE(failed.springs.empty());
+      expectRefused(r->mesh, broken, "non-finite or negative mass");
     }
     if (mesh_ptr == &box12 && surface == &complete) {
       // Every element the cut kept turned inside out (two nodes swapped: the same element to
-      // the comparison, of negative volume): the springs of the touched nodes meet such tets
-      // in many chunks; the error is the one of one pass, with or without the thread.
+      // the comparison, of negative volume).
       cutting::TetMesh inverted = r->mesh;
       std::vector<std::uint8_t> added(static_cast<size_t>(inverted.numTets()), 0);
       for (int t : r->change.added_elements) added[t] = 1;
       for (int t = 0; t < inverted.numTets(); ++t)
         if (!added[t]) std::swap(inverted.T(t, 0), inverted.T(t, 1));
-      CutUpdate3DPrepared alone, beside;
-      const Status one = prepareModelAfterCut3D(*built, mesh, inverted, r->change, {}, &alone);
-      testing::ThreadBeside threads;
-      CutUpdate3DOptions options;
-      options.beside = threads.lend();
-      const Status two = prepareModelAfterCut3D(*built, mesh, inverted, r->change, options, &beside);
-      ASSERT_FALSE(one.ok());
-      ASSERT_FALSE(two.ok());
-      EXPECT_NE(one.error().find("non-positive volume"), std::string::npos) << one.error();
-      EXPECT_EQ(one.error(), two.error());
-      EXPECT_EQ(threads.jobs(), 2);
-      for (const std::thread& t : threads.threads) EXPECT_FALSE(t.joinable());
-      EXPECT_TRUE(alone.springs.empty());
-      EXPECT_TRUE(beside.springs.empty());
+      expectRefused(inverted, *built, "non-positive volume");
     }
   }
 }

@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include "run_hysim.hpp"
+#include "slab_scenes.hpp"
 
 #include <array>
 #include <cstdio>
@@ -164,6 +165,38 @@ TEST(Cli, SameSceneTwiceSameHash) {
   ASSERT_EQ(hysim("run --steps 100 --quiet --report " + dir + "/b.json").exit_code, 0);
   std::ifstream a(dir + "/a.json"), b(dir + "/b.json");
   EXPECT_EQ(nlohmann::json::parse(a)["state_hash"], nlohmann::json::parse(b)["state_hash"]);
+}
+
+// The real-time mode paces the same state sequence to the wall clock with the haptic thread
+// beside it; the synchronous cut and a run pinned to one core give the same states too.
+TEST(Cli, RealtimeRunIsTheSameRunWithTheHapticThread) {
+  const std::string dir = outDir("realtime");
+  const std::string scene = hysim::testing::writeSlabScene(dir, true);
+  auto report = [&](const std::string& name, const std::string& flags, const std::string& prefix = "") {
+    const Output o = hysim::testing::runHysim("run " + scene + " --quiet " + flags + " --report " + dir + "/" + name,
+                                              prefix);
+    EXPECT_EQ(o.exit_code, 0) << o.text;
+    std::ifstream in(dir + "/" + name);
+    return nlohmann::json::parse(in);
+  };
+  const auto fast = report("fast.json", "");
+  const auto paced = report("paced.json", "--realtime");
+  const auto one_core = report("one_core.json", "--realtime", "taskset -c 0");
+  const auto sync = report("sync.json", "--sync-cut");
+  EXPECT_EQ(fast["passes"].get<int>(), 1);
+  for (const auto* r : {&paced, &one_core, &sync}) EXPECT_EQ((*r)["state_hash"], fast["state_hash"]);
+  EXPECT_FALSE(fast["realtime"].get<bool>());
+  EXPECT_EQ(sync["cut_mode"], "sync");
+  EXPECT_EQ(sync["stalls"].get<int>(), 0);
+  for (const auto* r : {&paced, &one_core}) {
+    EXPECT_TRUE((*r)["realtime"].get<bool>());
+    // 1.3 s of simulated time at 1 kHz; the counts, not the timing, are asserted.
+    EXPECT_GT((*r)["haptic_ticks"].get<long>(), 500);
+    EXPECT_GT((*r)["haptic_period_us"]["p50"].get<double>(), 0.0);
+    EXPECT_GE((*r)["wall_s"].get<double>(), 1.2);
+    EXPECT_GT((*r)["cut_latency_ms"]["median"].get<double>(), 0.0);
+    EXPECT_EQ((*r)["per_pass"][0]["commit_step"].get<int>() - (*r)["per_pass"][0]["exit_step"].get<int>(), 20);
+  }
 }
 
 }  // namespace

@@ -25,7 +25,6 @@
 #include <functional>
 #include <vector>
 
-#include "hysim/cutting/beside.hpp"
 #include "hysim/cutting/cut2d.hpp"  // CutMethod, parseCutMethod, cutMethodName
 #include "hysim/cutting/cut_surface.hpp"
 #include "hysim/cutting/mesh.hpp"
@@ -59,10 +58,10 @@ struct Optimize3DOptions {
   double step_gain = 0.3;
   double stop_fraction = 0.02;
   int max_iterations = 8;
-  // Each move iteration's nodes are split into two parts with no neighbours in common that
-  // move side by side (on Cut3DOptions::beside's thread where given; the result does not
-  // depend on it), the rest after them, split again; lists shorter than this move one node
-  // after another. 0 or 1: always split where a split leaves both parts nodes.
+  // Each move iteration's nodes are split into two parts with no neighbours in common, each
+  // moving within half of the move budget left, then the rest, split again; lists shorter
+  // than this move one node after another. The split sets the move order, so it is part of
+  // the result. 0 or 1: always split where a split leaves both parts nodes.
   int parallel_min_nodes = 8;
   double quality_target = 0.12;  // q* in [0, 1/3]; nodes with better neighbourhoods stay
   bool move_cut_nodes = true;
@@ -196,12 +195,6 @@ struct Cut3DOptions {
   double on_surface_tolerance = 1e-9;  // eps relative to the mesh bounding-box diagonal
   bool separate = true;             // duplicate the nodes on the cut
   Optimize3DOptions optimize;       // Hybrid only
-  // Optional: starts a job on another thread and returns what waits for it. cut3d hands it
-  // work that only reads the input mesh (its node -> tets lists), done beside the surface
-  // tests, and half of each move iteration of the optimisation (parallel_min_nodes); the
-  // result is the same. Empty: everything runs on the calling thread. cut3d waits for each
-  // job before it starts the next.
-  Beside beside;
   // Optional (hybrid): the nodes that hold the tissue in place. Given, the pieces the cut
   // cuts off (node-connected parts of the cut mesh with no anchored node, such as a chip
   // the caller removes) are left as the cut made them: the optimisation works on the rest

@@ -11,6 +11,7 @@
 
 #include "hysim/cutting/mesh.hpp"
 #include "hysim/engine/chips.hpp"
+#include "hysim/engine/mesh_faces.hpp"
 #include "hysim/engine/pass_record.hpp"
 #include "hysim/engine/scene.hpp"
 #include "hysim/engine/tissue.hpp"
@@ -41,13 +42,26 @@ struct StateRemap {
              sim::NodeVectors& v) const;
 };
 
+// The free pieces of a cut (scene chips: simulate), kept to become chips at the commit step,
+// where the pieces are then: the cut mesh, a state map onto all of its nodes, its pieces and
+// its nodes on a cut surface.
+struct ChipSource {
+  cutting::TetMesh mesh;
+  StateRemap remap;
+  Pieces pieces;
+  std::vector<std::uint8_t> on_cut;
+};
+// The chips of `source` at the state (x, v) of the epoch that was cut.
+std::vector<ChipShape> chipsAt(const ChipSource& source, const Scene& scene, const sim::NodeVectors& x,
+                               const sim::NodeVectors& v);
+
 struct CutOutcome {
   Status status;                   // not ok: the cut was refused, the epoch stays
   PassRecord record;               // what the job did and its wall times
   std::unique_ptr<Tissue> tissue;  // the next epoch
   StateRemap remap;
   std::vector<int> old_to_kept;    // #N of the epoch cut: its node in the next one, or -1
-  std::vector<ChipShape> chips;    // free pieces at the exit step (scene chips: simulate)
+  ChipSource chips;                // free pieces (empty unless scene chips: simulate)
   sim::State state;                // step arrays sized for the next model; x, v filled at commit
 };
 

@@ -1,5 +1,5 @@
 #pragma once
-// The cut worker: one named thread ("hysim-cut") that runs whole jobs, one at a time, beside
+// The cut worker: one named thread ("hysim-cut") that runs whole jobs, one at a time, next to
 // the simulation thread. The simulation hands it a shaving pass's cut and collects the
 // result at a fixed later step; nothing it computes depends on when it runs.
 #include <condition_variable>

@@ -40,7 +40,7 @@ struct Tissue {
   std::vector<int> contact_nodes;                // free surface nodes (contact candidates)
   TissueCollision collision;                     // boundary faces (FCL)
   TetLocator locator;
-  // The lookups mapping a deformed point to the rest shape needs besides the locator: the
+  // The lookups mapping a deformed point to the rest shape needs apart from the locator: the
   // nearest surface node (grid over nearest_x, the positions it was built at) and a tet at
   // each node. nearest refers to nearest_x and surface_nodes: a Tissue is never copied.
   sim::NodeVectors nearest_x;

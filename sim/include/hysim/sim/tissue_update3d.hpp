@@ -8,7 +8,6 @@
 #include <Eigen/Core>
 #include <vector>
 
-#include "hysim/cutting/beside.hpp"
 #include "hysim/cutting/mesh.hpp"
 #include "hysim/cutting/result.hpp"
 #include "hysim/cutting/topology_change.hpp"
@@ -120,15 +119,6 @@ struct CutUpdate3DOptions {
   // already needs more substeps than allowed) stops there: the round's estimate replaces it,
   // so the model is the same to the last bit (false: every estimate runs to convergence).
   bool stop_decided_estimates = true;
-  // Optional: starts a job on another thread and returns what waits for it (as
-  // cutting::Cut3DOptions::beside). The first part hands it the comparison of the elements
-  // with the old ones (beside the node -> tets lists) and the springs between touched nodes
-  // (beside the masses), and the second part the step's spring arrays (filled beside the
-  // stability estimate, which reads lists of its own built there first); the result is the
-  // same to the last bit. Empty: one thread. The
-  // jobs must not wait behind the caller (a PassWorker lent from a job on that worker would
-  // wait for itself), and one that throws (bad_alloc only) ends the program.
-  cutting::Beside beside;
 };
 
 struct CutUpdate3DReport {
@@ -141,9 +131,9 @@ struct CutUpdate3DReport {
   bool held_stability = false;    // the previous mode was near the cut: omega_max = max(local, previous)
   double omega_local = 0.0;       // rad/s, estimate near the cut (or the upper bound that made it unneeded)
   double omega_previous = 0.0;    // rad/s
-  // Wall time (ms), for profiling: the first part (masses and springs around the cut), and in
-  // the second the model's springs (carried over and recomputed, the step's arrays) and the
-  // stability estimates (with the rounds of mass scaling).
+  // Wall time (ms), for profiling: the masses and springs around the cut (prepare_ms), the
+  // model's springs carried over and recomputed with the step's arrays (springs_ms), and the
+  // stability estimates with the rounds of mass scaling (stability_ms).
   double prepare_ms = 0.0, springs_ms = 0.0, stability_ms = 0.0;
 };
 
@@ -155,31 +145,6 @@ struct CutUpdate3DReport {
 Status updateModelAfterCut3D(Model& model, const cutting::TetMesh& before, const cutting::TetMesh& after,
                              const cutting::TopologyChange& change, const std::vector<std::uint8_t>& fixed_after,
                              const std::vector<std::int32_t>& node_to_kept, const CutUpdate3DOptions& options = {},
-                             CutUpdate3DReport* report = nullptr);
-
-// updateModelAfterCut3D in two parts, so that the first can run while the caller finds the
-// pieces the cut set free (it does not depend on which nodes are kept): prepare computes the
-// cut mesh's masses and the springs between touched nodes; finish drops the free pieces,
-// renumbers, updates the model in place and estimates its stability. `model` must not change
-// between the two. The same model as updateModelAfterCut3D, to the last bit.
-struct CutUpdate3DPrepared {
-  struct Spring {
-    int a, b;  // nodes of `after`
-    double rest, k, c;
-  };
-  int num_nodes_before = -1;
-  CutUpdate3DReport report;            // filled so far: masses, touched_nodes, springs_recomputed, omega_previous
-  Eigen::VectorXd mass;                // #N of after
-  std::vector<std::uint8_t> touched;   // #N of after: masses and springs between them recomputed
-  std::vector<std::uint8_t> region;    // #N of after: touched and their rings (mass region)
-  std::vector<Spring> springs;         // recomputed, in buildModel's order
-};
-Status prepareModelAfterCut3D(const Model& model, const cutting::TetMesh& before, const cutting::TetMesh& after,
-                              const cutting::TopologyChange& change, const CutUpdate3DOptions& options,
-                              CutUpdate3DPrepared* prepared);
-Status finishModelAfterCut3D(Model& model, const cutting::TetMesh& after, const cutting::TopologyChange& change,
-                             const std::vector<std::uint8_t>& fixed_after, const std::vector<std::int32_t>& node_to_kept,
-                             const CutUpdate3DOptions& options, CutUpdate3DPrepared& prepared,
                              CutUpdate3DReport* report = nullptr);
 
 }  // namespace hysim::sim
