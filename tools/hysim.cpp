@@ -1,12 +1,16 @@
 // hysim: the command-line entry. `hysim run` steps a scene headless and writes PNG frames
 // and a JSON report; `hysim stats` prints mesh statistics with the paper's columns.
 #include <CLI/CLI.hpp>
+#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <memory>
 #include <nlohmann/json.hpp>
+#include <random>
 #include <string>
+#include <thread>
 
 #include "hysim/cutting/mesh_io.hpp"
 #include "hysim/cutting/mesh_stats.hpp"
@@ -60,6 +64,7 @@ struct RunArgs {
   std::string dump_cuts;  // folder for each pass's cut input (debugging)
   bool realtime = false;  // pace to the wall clock with the haptic thread
   bool sync_cut = false;  // cut on the simulation thread (reference mode)
+  int cut_delay_ms = 0;   // debugging: the worker sleeps a random 0..N ms before each cut
 };
 
 int runCommand(const RunArgs& args) {
@@ -77,6 +82,13 @@ int runCommand(const RunArgs& args) {
     fs::create_directories(args.dump_cuts, ec);
     if (ec) return fail("cannot create folder '" + args.dump_cuts + "': " + ec.message());
     (*sim)->setCutDumpDir(args.dump_cuts);
+  }
+  if (args.cut_delay_ms > 0) {  // the same random sequence every run: only the timing changes
+    auto rng = std::make_shared<std::mt19937>(12345u);
+    const int most = args.cut_delay_ms;
+    (*sim)->setCutDelayForTesting([rng, most] {
+      std::this_thread::sleep_for(std::chrono::milliseconds(std::uniform_int_distribution<int>(0, most)(*rng)));
+    });
   }
 
   std::unique_ptr<render::OffscreenRenderer> renderer;
@@ -181,6 +193,9 @@ int main(int argc, char** argv) {
   run_cmd->add_flag("--realtime", run.realtime,
                     "Pace the steps to the wall clock, with the haptic thread (1 kHz) rendering forces on a simulated "
                     "device; the state sequence is the same as without");
+  run_cmd->add_option("--cut-delay-ms", run.cut_delay_ms,
+                      "Debugging: the cut worker sleeps a random 0..N ms before each cut (the states must not change)")
+      ->check(CLI::Range(0, 10000));
   run_cmd->add_flag("--sync-cut", run.sync_cut,
                     "Reference mode: cut on the simulation thread at the pass's exit step (committed at the same "
                     "step as the worker's cut; the same state_hash)");
