@@ -89,6 +89,7 @@ void HapticLoop::tick(std::int64_t now_ns) {
   const DeviceState state = device_->read(time_s);
   states_.publish(state);
   const double f0_scale = watchdog_.update(takeNewModel(), now_ns);
+  f0_scale_.store(f0_scale, std::memory_order_relaxed);
   const Eigen::Vector3d command_n = model_.force(state.pose.tip, state.velocity_mm_s, f0_scale);
   device_->commandForce(safety_.filter(command_n, now_ns));
   publishSafety();

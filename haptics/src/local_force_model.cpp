@@ -1,6 +1,7 @@
 #include "hysim/haptics/local_force_model.hpp"
 
 #include <Eigen/Eigenvalues>
+#include <Eigen/SVD>
 #include <algorithm>
 
 namespace hysim::haptics {
@@ -31,13 +32,18 @@ double weakestDamping(const Eigen::Matrix3d& damping) {
   return solver.eigenvalues()(0);  // sorted increasing
 }
 
+// Largest stiffness over all directions (largest singular value).
+double spectralNorm(const Eigen::Matrix3d& m) {
+  return Eigen::JacobiSVD<Eigen::Matrix3d>(m).singularValues()(0);  // sorted decreasing
+}
+
 }  // namespace
 
 LocalForceModel limitToDevice(const LocalForceModel& model, const DeviceInfo& info, double period_s) {
   if (!allFinite(model)) return model;
   LocalForceModel limited = model;
   const double max_k = info.max_stiffness_n_per_mm;
-  double k = limited.stiffness_n_per_mm.norm();  // Frobenius
+  double k = spectralNorm(limited.stiffness_n_per_mm);
   if (k > max_k) {
     limited.stiffness_n_per_mm *= max_k / k;
     k = max_k;

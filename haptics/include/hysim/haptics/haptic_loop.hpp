@@ -73,10 +73,11 @@ class HapticLoop {
   FaultReason faultReason() const { return fault_reason_.load(); }
   HapticStats stats() const;  // any thread; allocates (not for the haptic thread)
   bool realtime() const { return realtime_.load(); }
+  // The watchdog's scale of F0 at the last tick (1: models arrive; 0: faded out). Any thread.
+  double f0Scale() const { return f0_scale_.load(std::memory_order_relaxed); }
 
   // Only while not running.
   Device& device() { return *device_; }
-  double f0Scale() const { return watchdog_.scale(); }
   std::int64_t periodNs() const { return period_ns_; }
 
  private:
@@ -112,6 +113,7 @@ class HapticLoop {
   std::atomic<bool> realtime_{false};
   std::atomic<SafetyState> safety_state_{SafetyState::WaitingForSmall};
   std::atomic<FaultReason> fault_reason_{FaultReason::None};
+  std::atomic<double> f0_scale_{1.0};
   std::atomic<long> ticks_{0};
   std::atomic<long> overruns_{0};
   std::atomic<long> resyncs_{0};

@@ -47,10 +47,10 @@ bool isPassive(const CouplingGains& gains, double period_s);
 // kMinCouplingDamping_n_s_per_mm.
 CouplingGains couplingGains(const DeviceInfo& info, double period_s);
 
-// The model with its stiffness scaled down so that its Frobenius norm is at most the device's
-// max_stiffness_n_per_mm (the Frobenius norm bounds every eigenvalue's magnitude, so no
-// direction exceeds the limit), and its damping raised, if needed, until the weakest
-// direction of the symmetric part of -D damps at least |K|_F * T (twice the passivity bound).
+// The model with its stiffness scaled down so that its spectral norm (the stiffest direction)
+// is at most the device's max_stiffness_n_per_mm, and its damping raised, if needed, until
+// the weakest direction of the symmetric part of -D damps at least |K|_2 * T (twice the
+// passivity bound).
 // A model with a non-finite entry is returned unchanged so the safety layer sees the fault.
 LocalForceModel limitToDevice(const LocalForceModel& model, const DeviceInfo& info, double period_s);
 
