@@ -20,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "app_haptics.hpp"
 #include "tool_common.hpp"
 #include "hysim/engine/scene.hpp"
 #include "hysim/engine/simulation.hpp"
@@ -180,6 +181,7 @@ int runApp(const AppArgs& args) {
   const double path_end_s = haptics::Trajectory(scene->tool_path).duration();
 
   haptics::ManualDevice* manual_device = nullptr;  // owned by the simulation while in use
+  tools::AppHaptics force_feedback;
 
   const Clock::time_point start = Clock::now();
   Clock::time_point last = start;
@@ -203,6 +205,8 @@ int runApp(const AppArgs& args) {
           case SDLK_r: panel.reset_requested = true; break;
           case SDLK_l: panel.lens_index = (panel.lens_index + 1) % 3; break;
           case SDLK_m: panel.manual_requested = true; break;
+          case SDLK_x: force_feedback.eStop(); break;
+          case SDLK_f: force_feedback.resetSafety(); break;
           default: break;
         }
       }
@@ -257,6 +261,7 @@ int runApp(const AppArgs& args) {
         step_times.add(1e6 * seconds(Clock::now() - t0));
       }
     }
+    force_feedback.publish(*sim);
     const double tool_force_n = sim->toolForceN().norm();
     max_force_n = std::max(max_force_n, tool_force_n);
     if (elapsed > 0.0) {
@@ -308,6 +313,7 @@ int runApp(const AppArgs& args) {
     ImGui::Separator();
     ImGui::Text("tool force   %8.3f N", tool_force_n);
     ImGui::Text("max force    %8.3f N", max_force_n);
+    force_feedback.drawPanel();
     if (st.warnings > 0) {
       ImGui::TextColored(ImVec4(1.0f, 0.35f, 0.3f, 1.0f), "warnings     %8d  (numerical trouble)", st.warnings);
     } else {
@@ -339,6 +345,7 @@ int runApp(const AppArgs& args) {
     } else {
       ImGui::TextDisabled("scope follows the scene's scripted path");
     }
+    ImGui::TextDisabled("X: force e-stop, F: reset force");
     ImGui::TextDisabled("Esc: quit");
     ImGui::End();
     (*layer)->render();

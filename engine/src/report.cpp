@@ -91,6 +91,11 @@ std::string reportJson(const RunReport& r) {
   j["state_hash"] = hashHex(r.state_hash);
   j["warnings"] = r.warnings;
   j["max_tool_force_n"] = r.max_tool_force_n;
+  j["coupling"] = {{"mode", r.coupling},
+                   {"stiffness_n_per_mm", r.coupling_stiffness_n_per_mm},
+                   {"damping_n_s_per_mm", r.coupling_damping_n_s_per_mm}};
+  j["max_hand_force_n"] = r.max_hand_force_n;
+  j["max_coupling_offset_mm"] = r.max_coupling_offset_mm;
   j["wall_s"] = r.wall_s;
   nlohmann::ordered_json per_pass = nlohmann::ordered_json::array();
   for (const PassRecord& p : r.passes) {

@@ -31,6 +31,10 @@ void describe(const Simulation& sim, RunReport& r) {
   r.integrator = scene.sim.integrator == sim::Integrator::ImplicitEuler ? "implicit_euler" : "symplectic_euler";
   r.commit_steps = scene.cut.commit_steps;
   r.cut_mode = scene.cut.mode == CutSettings::Mode::Sync ? "sync" : "async";
+  const bool rigid = scene.coupling.mode == CouplingSettings::Mode::Rigid;
+  r.coupling = rigid ? "rigid" : "spring";
+  r.coupling_stiffness_n_per_mm = rigid ? 0.0 : sim.couplingGains().stiffness_n_per_mm;
+  r.coupling_damping_n_s_per_mm = rigid ? 0.0 : sim.couplingGains().damping_n_s_per_mm;
 }
 
 // What the simulation knows at the end of the run.
@@ -63,17 +67,6 @@ void collect(const Simulation& sim, RunReport& r) {
     r.chips_over_cap = chips->removedOverCap();
     r.chip_step_us_mean = sim.chipSteps() > 0 ? 1e6 * sim.chipStepSeconds() / static_cast<double>(sim.chipSteps()) : 0.0;
   }
-}
-
-// The local force model of the last step for the haptic thread: the contact reaction and how
-// it changes about the tool's position there.
-haptics::LocalForceModel forceModel(const Simulation& sim) {
-  haptics::LocalForceModel m;
-  m.step = static_cast<std::int64_t>(sim.state().steps);
-  m.f0_n = sim.toolForceN();
-  m.stiffness_n_per_mm = sim.toolStiffnessNPerMm();
-  m.x_ref_mm = sim.toolPose().tip;
-  return m;
 }
 
 // The haptic thread of a realtime run: the scene's script on a simulated device of its own
@@ -140,8 +133,10 @@ Result<RunReport> run(Simulation& sim, const RunOptions& options) {
     const auto t0 = Clock::now();
     sim.step();
     step_us.push_back(usSince(t0));
-    if (haptic) haptic->publishModel(forceModel(sim));
+    if (haptic) haptic->publishModel(sim.hapticModel());
     r.max_tool_force_n = std::max(r.max_tool_force_n, sim.toolForceN().norm());
+    r.max_hand_force_n = std::max(r.max_hand_force_n, sim.handForceN().norm());
+    r.max_coupling_offset_mm = std::max(r.max_coupling_offset_mm, sim.couplingOffsetMm());
     if ((i + 1) % every == 0) {
       if (Status st = frame(); !st.ok()) return Error{st.error()};
     }

@@ -245,12 +245,25 @@ void parseCut(const Reader& r, const YAML::Node& n, CutSettings& c) {
   if (n["commit_steps"]) c.commit_steps = r.integer(n["commit_steps"], "commit_steps", 0, 1000);
 }
 
+void parseCoupling(const Reader& r, const YAML::Node& n, CouplingSettings& c) {
+  r.checkKeys(n, "coupling", {"mode", "stiffness_n_per_mm", "damping_n_s_per_mm"});
+  if (n["mode"]) {
+    const std::string s = r.string(n["mode"], "mode");
+    if (s == "spring") c.mode = CouplingSettings::Mode::Spring;
+    else if (s == "rigid") c.mode = CouplingSettings::Mode::Rigid;
+    else r.fail(n["mode"], "'coupling.mode' must be spring or rigid, got '" + s + "'");
+  }
+  if (n["stiffness_n_per_mm"]) c.stiffness_n_per_mm = r.positive(n["stiffness_n_per_mm"], "stiffness_n_per_mm");
+  if (n["damping_n_s_per_mm"]) c.damping_n_s_per_mm = r.positive(n["damping_n_s_per_mm"], "damping_n_s_per_mm");
+}
+
 Scene parse(const Reader& r, const YAML::Node& root, const std::string& path) {
   Scene scene;
   scene.path = path;
   if (!root.IsDefined() || root.IsNull()) r.fail(root, "the scene file is empty");
   r.checkKeys(root, "scene", {"name", "description", "mesh", "tool_mesh", "materials", "anchors", "simulation",
-                              "contact", "safety", "tool_path", "camera", "render", "chips", "cut"});
+                              "contact", "safety", "tool_path", "camera", "render", "chips", "cut",
+                              "coupling"});
   const fs::path dir = fs::path(path).parent_path();
   auto resolve = [&](const YAML::Node& n, const std::string& key) {
     const std::string rel = r.string(n, key);
@@ -292,6 +305,7 @@ Scene parse(const Reader& r, const YAML::Node& root, const std::string& path) {
   }
   if (root["chips"]) parseChips(r, root["chips"], scene.chips);
   if (root["cut"]) parseCut(r, root["cut"], scene.cut);
+  if (root["coupling"]) parseCoupling(r, root["coupling"], scene.coupling);
 
   const YAML::Node tp = r.require(root, "tool_path", "scene");
   if (!tp.IsSequence() || tp.size() == 0) r.fail(tp, "'tool_path' must be a non-empty list of keyframes");

@@ -28,6 +28,28 @@ Eigen::Vector3d closestOnSegment(const Eigen::Vector3d& p, const Eigen::Vector3d
   return a + t * ab;
 }
 
+// The coupling's gains: the device's (the scripted device's limits; a hardware device is not
+// stiffer) unless the scene sets them, which must stay within the device's stiffness and
+// above the passivity bound at the device's rate.
+Result<haptics::CouplingGains> couplingFor(const Scene& scene) {
+  const haptics::DeviceInfo device = haptics::ScriptedDevice::defaultInfo();
+  const double period_s = 1.0 / device.rate_hz;
+  haptics::CouplingGains gains = haptics::couplingGains(device, period_s);
+  const CouplingSettings& c = scene.coupling;
+  if (c.stiffness_n_per_mm > 0.0) gains.stiffness_n_per_mm = c.stiffness_n_per_mm;
+  if (c.damping_n_s_per_mm > 0.0) gains.damping_n_s_per_mm = c.damping_n_s_per_mm;
+  if (gains.stiffness_n_per_mm > device.max_stiffness_n_per_mm) {
+    return Error{scene.path + ": coupling.stiffness_n_per_mm " + std::to_string(gains.stiffness_n_per_mm) +
+                 " is stiffer than the device renders (" + std::to_string(device.max_stiffness_n_per_mm) + ")"};
+  }
+  if (!haptics::isPassive(gains, period_s)) {
+    return Error{scene.path + ": coupling.damping_n_s_per_mm " + std::to_string(gains.damping_n_s_per_mm) +
+                 " is at or below the passivity bound k T / 2 = " +
+                 std::to_string(0.5 * gains.stiffness_n_per_mm * period_s) + " N s/mm"};
+  }
+  return gains;
+}
+
 }  // namespace
 
 Result<render::SurfaceMesh> loadSurface(const std::string& path, render::SurfaceMaterial material) {
@@ -127,8 +149,10 @@ Result<std::unique_ptr<Simulation>> Simulation::create(const Scene& scene) {
     return Error{scene.mesh_path + ": invalid mesh: " + valid.error()};
   }
 
-  s->device_ = std::make_unique<haptics::ScriptedDevice>(haptics::Trajectory(scene.tool_path));
-  s->pose_ = s->device_->read(0.0).pose;
+  auto coupling = couplingFor(scene);
+  if (!coupling.ok()) return Error{coupling.error()};
+  s->coupling_ = haptics::VirtualCoupling(coupling.value(), scene.sim.dt);
+  s->setDevice(std::make_unique<haptics::ScriptedDevice>(haptics::Trajectory(scene.tool_path)));
   s->loop_.loop_radius_mm = scene.contact.loop_radius_mm;
   s->loop_.reach_mm = scene.contact.loop_reach_mm;
   s->loop_.drop_mm = scene.contact.loop_drop_mm;
@@ -170,6 +194,36 @@ Result<std::unique_ptr<Simulation>> Simulation::create(const Scene& scene) {
     s->tool_surface_ = std::move(tool.value());
   }
   return s;
+}
+
+void Simulation::setDevice(std::unique_ptr<haptics::Device> device) {
+  device_ = std::move(device);
+  device_state_ = device_->read(state_.time);
+  pose_ = device_state_.pose;
+  coupling_.reset(pose_.tip, device_state_.velocity_mm_s);
+}
+
+void Simulation::followDevice() {
+  device_state_ = device_->read(state_.time + scene_.sim.dt);
+  pose_ = device_state_.pose;
+  if (scene_.coupling.mode == CouplingSettings::Mode::Spring) {
+    // The tissue's reaction of the last step, at the proxy where it was then.
+    coupling_.step(device_state_.pose.tip, device_state_.velocity_mm_s, tool_force_n_, tool_stiffness_);
+    pose_.tip = coupling_.proxyTip();
+  }
+}
+
+haptics::LocalForceModel Simulation::hapticModel() const {
+  const auto step = static_cast<std::int64_t>(state_.steps);
+  if (scene_.coupling.mode == CouplingSettings::Mode::Spring) {
+    return coupling_.forceModel(step, device_state_.pose.tip, device_state_.velocity_mm_s);
+  }
+  haptics::LocalForceModel m;
+  m.step = step;
+  m.f0_n = tool_force_n_;
+  m.stiffness_n_per_mm = tool_stiffness_;
+  m.x_ref_mm = pose_.tip;
+  return m;
 }
 
 void Simulation::computeContact() {
@@ -259,7 +313,7 @@ void Simulation::step() {
   if (pending_ && state_.steps >= pending_->commit_step) commitCut();
   // The pose for the end of this step drives the contact of this step.
   const Eigen::Vector3d previous_tip = pose_.tip;
-  pose_ = device_->read(state_.time + scene_.sim.dt).pose;
+  followDevice();
   path_length_mm_ += (pose_.tip - previous_tip).norm();
   if (pose_.pedal) electrode_active_s_ += scene_.sim.dt;
   computeContact();
@@ -272,7 +326,10 @@ void Simulation::step() {
     tool_force_n_ /= static_cast<double>(contact_calls_);
     tool_stiffness_ /= static_cast<double>(contact_calls_);
   }
-  device_->commandForce(tool_force_n_);  // clamped and NaN-guarded by the device
+  hand_force_n_ = scene_.coupling.mode == CouplingSettings::Mode::Spring
+                      ? coupling_.handForce(device_state_.pose.tip, device_state_.velocity_mm_s)
+                      : tool_force_n_;
+  device_->commandForce(hand_force_n_);  // clamped and NaN-guarded by the device
   if (chips_) {
     chips_->moveTool(pose_);
     if (chips_->numChips() > 0) {
@@ -282,10 +339,13 @@ void Simulation::step() {
       ++chip_steps_;
     }
   }
+  advanceShaving();
+}
 
-  // Shaving: entry is the first contact of the active loop with the tissue (its sweep over
-  // this step touches the surface, or it is buried); the sweep grows while it touches; on
-  // exit (no contact any more, or pedal release) the sweep is cut. Collision runs only while
+void Simulation::advanceShaving() {
+  // Entry is the first contact of the active loop with the tissue (its sweep over this step
+  // touches the surface, or it is buried); the sweep grows while it touches; on exit (no
+  // contact any more, or pedal release) the sweep goes to the cut. Collision runs only while
   // the electrode is active or a pass is open.
   previous_wire_ = wire_;
   loopPoints(loop_, pose_, wire_);

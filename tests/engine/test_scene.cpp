@@ -129,6 +129,21 @@ TEST(SceneErrors, UnknownIntegrator) {
               "'integrator' must be symplectic_euler or implicit_euler, got 'rk4'");
 }
 
+TEST(Scene, CouplingParses) {
+  auto scene = loadScene(writeFile("coupling.yaml", minimalScene() + "coupling: {mode: rigid, stiffness_n_per_mm: 0.5}\n"));
+  ASSERT_TRUE(scene.ok()) << scene.error();
+  EXPECT_EQ(scene->coupling.mode, CouplingSettings::Mode::Rigid);
+  EXPECT_DOUBLE_EQ(scene->coupling.stiffness_n_per_mm, 0.5);
+  EXPECT_DOUBLE_EQ(scene->coupling.damping_n_s_per_mm, 0.0);  // the default: from the passivity bound
+}
+
+TEST(SceneErrors, BadCoupling) {
+  expectError("coupling_mode.yaml", minimalScene() + "coupling: {mode: glue}\n", ":11:",
+              "'coupling.mode' must be spring or rigid, got 'glue'");
+  expectError("coupling_k.yaml", minimalScene() + "coupling: {stiffness_n_per_mm: -1}\n", ":11:",
+              "'stiffness_n_per_mm' must be positive");
+}
+
 TEST(SceneErrors, TimeGoesBackwards) {
   expectError("backwards.yaml", minimalScene() + "  - {t_s: -1, tip: [0, 0, 0], axis: [0, 0, 1]}\n", ":11:",
               "'t_s' must not be negative");

@@ -70,6 +70,48 @@ TEST(Simulation, LoopPushesTheMyomaAndFeelsIt) {
   EXPECT_EQ((*with)->state().warnings, 0);
 }
 
+// The loop pressing on the myoma (as above): with the spring coupling the tool lags the
+// device by the force over the coupling's stiffness, and the hand feels the coupling, which
+// the published local model reproduces; with a rigid coupling the tool is the device and the
+// hand feels the tissue's reaction.
+TEST(Simulation, TheToolFollowsTheDeviceThroughTheCoupling) {
+  Scene scene = defaultScene();
+  auto spring = Simulation::create(scene);
+  scene.coupling.mode = CouplingSettings::Mode::Rigid;
+  auto rigid = Simulation::create(scene);
+  ASSERT_TRUE(spring.ok() && rigid.ok());
+  Simulation& s = **spring;
+  const double k = s.couplingGains().stiffness_n_per_mm;
+  double max_offset = 0.0, max_force = 0.0;
+  for (int i = 0; i < 2300; ++i) {
+    s.step();
+    (*rigid)->step();
+    max_offset = std::max(max_offset, s.couplingOffsetMm());
+    max_force = std::max(max_force, s.toolForceN().norm());
+    const haptics::DeviceState& d = s.deviceState();
+    ASSERT_LT((s.hapticModel().force(d.pose.tip, d.velocity_mm_s) - s.handForceN()).norm(), 1e-9) << "step " << i;
+    ASSERT_EQ((*rigid)->couplingOffsetMm(), 0.0);
+    ASSERT_EQ((*rigid)->handForceN(), (*rigid)->toolForceN());
+  }
+  EXPECT_GT(max_force, 0.05);
+  EXPECT_GT(max_offset, 0.5 * max_force / k);
+  EXPECT_LT(max_offset, 2.0 * max_force / k + 0.01);
+  EXPECT_EQ(s.state().warnings, 0);
+}
+
+TEST(Simulation, CouplingBeyondTheDeviceIsAnError) {
+  Scene scene = defaultScene();
+  scene.coupling.stiffness_n_per_mm = 50.0;
+  auto stiff = Simulation::create(scene);
+  ASSERT_FALSE(stiff.ok());
+  EXPECT_NE(stiff.error().find("coupling.stiffness_n_per_mm 50"), std::string::npos) << stiff.error();
+  scene.coupling.stiffness_n_per_mm = 1.0;
+  scene.coupling.damping_n_s_per_mm = 1e-4;  // below k T / 2 = 5e-4
+  auto loose = Simulation::create(scene);
+  ASSERT_FALSE(loose.ok());
+  EXPECT_NE(loose.error().find("passivity bound"), std::string::npos) << loose.error();
+}
+
 TEST(Simulation, SnapshotCarriesSurfaceCameraAndTool) {
   auto sim = Simulation::create(defaultScene());
   ASSERT_TRUE(sim.ok());

@@ -57,6 +57,10 @@ struct RunReport {
   std::uint64_t state_hash = 0;
   int warnings = 0;
   double max_tool_force_n = 0.0;
+  std::string coupling = "spring";
+  double coupling_stiffness_n_per_mm = 0.0, coupling_damping_n_s_per_mm = 0.0;
+  double max_hand_force_n = 0.0;        // the device's command (the coupling's force)
+  double max_coupling_offset_mm = 0.0;  // simulated tool tip behind the device's tip
   double wall_s = 0.0;
   std::vector<PassRecord> passes;  // shaving passes (cuts), in order
   double initial_myoma_mm3 = 0.0;

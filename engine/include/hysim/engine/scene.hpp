@@ -77,6 +77,18 @@ struct CutSettings {
   int commit_steps = 20;
 };
 
+// How the simulated tool follows the device. Spring: the tool's tip is a proxy that a
+// spring-damper pulls towards the device's tip while the tissue pushes it back (virtual
+// coupling); the hand feels the spring. Its gains default to the device's stiffest spring and
+// twice the passivity bound (haptics::couplingGains); a value > 0 here replaces one.
+// Rigid: the tool is where the device is, and the hand feels the tissue's reaction directly.
+struct CouplingSettings {
+  enum class Mode { Spring, Rigid };
+  Mode mode = Mode::Spring;
+  double stiffness_n_per_mm = 0.0;  // 0: the device's max_stiffness_n_per_mm
+  double damping_n_s_per_mm = 0.0;  // 0: twice the passivity bound, k * dt
+};
+
 struct Scene {
   std::string path;        // the scene file
   std::string name;
@@ -94,6 +106,7 @@ struct Scene {
   RenderSettings render;
   ChipSettings chips;
   CutSettings cut;
+  CouplingSettings coupling;
 };
 
 // Parses and checks a scene file. Does not load the meshes (see Simulation::create).

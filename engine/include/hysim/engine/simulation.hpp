@@ -20,6 +20,8 @@
 #include "hysim/engine/tissue.hpp"
 #include "hysim/engine/tool.hpp"
 #include "hysim/haptics/device.hpp"
+#include "hysim/haptics/local_force_model.hpp"
+#include "hysim/haptics/virtual_coupling.hpp"
 #include "hysim/render/snapshot.hpp"
 #include "hysim/sim/model.hpp"
 
@@ -53,10 +55,15 @@ class Simulation {
   const cutting::TetMesh& mesh() const { return tissue_->mesh; }
   const sim::Model& model() const { return tissue_->model; }
   const sim::State& state() const { return state_; }
+  // The simulated tool: the device's pose, with the tip at the coupling's proxy (scene
+  // coupling: spring) or at the device's tip (rigid).
   const haptics::ToolPose& toolPose() const { return pose_; }
   const haptics::Device& device() const { return *device_; }
-  // Replaces the device that drives the tool (e.g. a keyboard device in the trainee app).
-  void setDevice(std::unique_ptr<haptics::Device> device) { device_ = std::move(device); }
+  // The device's state this step's tool followed.
+  const haptics::DeviceState& deviceState() const { return device_state_; }
+  // Replaces the device that drives the tool (e.g. a keyboard device in the trainee app); the
+  // coupling's proxy starts on its tip.
+  void setDevice(std::unique_ptr<haptics::Device> device);
   int numAnchored() const { return tissue_->num_anchored; }
   int numDeformableTets() const { return tissue_->num_deformable_tets; }  // tets with at least one free node
   int numSurfaceNodes() const { return static_cast<int>(tissue_->surface_nodes.size()); }
@@ -66,6 +73,15 @@ class Simulation {
   // semi-definite: pushing further in pushes back harder): the local model the haptic
   // thread renders between steps.
   const Eigen::Matrix3d& toolStiffnessNPerMm() const { return tool_stiffness_; }
+  // The force on the user's hand after the last step (what the device was commanded): the
+  // coupling spring-damper, or with a rigid coupling the tissue's reaction.
+  const Eigen::Vector3d& handForceN() const { return hand_force_n_; }
+  // The same force as a local model for the haptic thread, about the device's state of the
+  // last step (see haptics::LocalForceModel).
+  haptics::LocalForceModel hapticModel() const;
+  // Distance between the simulated tool's tip and the device's tip, mm (0 when rigid).
+  double couplingOffsetMm() const { return (pose_.tip - device_state_.pose.tip).norm(); }
+  const haptics::CouplingGains& couplingGains() const { return coupling_.gains(); }
   // Positions and velocities of the tissue, and the simulated chips' poses (when there are any).
   std::uint64_t stateHash() const { return chips_ ? chips_->hash(sim::stateHash(state_)) : sim::stateHash(state_); }
   // The simulated chips (scene `chips: simulate`); null when chips are removed.
@@ -112,12 +128,15 @@ class Simulation {
 
  private:
   Simulation() = default;
+  // Reads the device for the end of this step and places the tool (through the coupling).
+  void followDevice();
   void computeContact();
   static void contactForces(void* self, const sim::NodeVectors& x, const sim::NodeVectors& v);
   void contactForces(const sim::NodeVectors& x, const sim::NodeVectors& v);
   // Does the loop touch the tissue this step? Its sweep since the last step against the
   // boundary (FCL), else whether the wire is buried (one point in a tet).
   bool loopTouchesTissue();
+  // The shaving part of a step: pass entry, sweep rows, exit.
   void advanceShaving();
   // The pass ends: its sweep goes to the cut worker (or, in sync mode, is cut here), to be
   // committed scene.cut.commit_steps steps later.
@@ -148,7 +167,10 @@ class Simulation {
   std::unique_ptr<Tissue> tissue_;  // the epoch being stepped
   sim::State state_;
   std::unique_ptr<haptics::Device> device_;  // the scene's scripted device unless replaced
+  haptics::DeviceState device_state_;
+  haptics::VirtualCoupling coupling_{haptics::CouplingGains{}, 1e-3};
   haptics::ToolPose pose_;
+  Eigen::Vector3d hand_force_n_{0, 0, 0};
 
   sim::NodeVectors contact_force_;                // #N x 3, uN
   Eigen::Vector3d tool_force_n_{0, 0, 0};
