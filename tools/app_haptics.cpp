@@ -35,7 +35,7 @@ void AppHaptics::drawPanel() {
   }
   if (latched) ImGui::TextColored(red, "force off until reset (F)");
   ImGui::Text("hand force   %8.3f N", device_->renderedForceN());
-  if (loop_->f0Scale() < 1.0) ImGui::TextColored(amber, "simulation late: contact force faded");
+  if (loop_->f0Scale() < 1.0) ImGui::TextColored(amber, "no fresh force model (paused or late): F0 faded");
   if (ImGui::Button("E-stop (X)", ImVec2(140, 0))) eStop();
   ImGui::SameLine();
   if (ImGui::Button("Reset force (F)", ImVec2(-1, 0))) resetSafety();

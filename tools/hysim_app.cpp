@@ -235,7 +235,7 @@ int runApp(const AppArgs& args) {
       panel.manual_requested = false;
       panel.manual = !panel.manual;
       if (panel.manual) {
-        manual_device = new haptics::ManualDevice(sim->toolPose(), sim->state().time);
+        manual_device = new haptics::ManualDevice(sim->deviceState().pose, sim->state().time);
         sim->setDevice(std::unique_ptr<haptics::Device>(manual_device));
       } else {
         manual_device = nullptr;

@@ -28,9 +28,11 @@ Eigen::Vector3d closestOnSegment(const Eigen::Vector3d& p, const Eigen::Vector3d
   return a + t * ab;
 }
 
-// The coupling's gains: the device's (the scripted device's limits; a hardware device is not
-// stiffer) unless the scene sets them, which must stay within the device's stiffness and
-// above the passivity bound at the device's rate.
+// The coupling's gains: the device's unless the scene sets them, which must stay within the
+// device's stiffness and damp at least k T, what limitToDevice asks of every model (twice
+// the passivity bound), so the haptic thread renders the coupling the proxy was solved with.
+// The scripted, keyboard and mirrored devices share these limits; a hardware device with
+// other limits has to derive its own.
 Result<haptics::CouplingGains> couplingFor(const Scene& scene) {
   const haptics::DeviceInfo device = haptics::ScriptedDevice::defaultInfo();
   const double period_s = 1.0 / device.rate_hz;
@@ -42,10 +44,11 @@ Result<haptics::CouplingGains> couplingFor(const Scene& scene) {
     return Error{scene.path + ": coupling.stiffness_n_per_mm " + std::to_string(gains.stiffness_n_per_mm) +
                  " is stiffer than the device renders (" + std::to_string(device.max_stiffness_n_per_mm) + ")"};
   }
-  if (!haptics::isPassive(gains, period_s)) {
+  const double needed = gains.stiffness_n_per_mm * period_s;
+  if (!haptics::isPassive(gains, period_s) || gains.damping_n_s_per_mm < needed) {
     return Error{scene.path + ": coupling.damping_n_s_per_mm " + std::to_string(gains.damping_n_s_per_mm) +
-                 " is at or below the passivity bound k T / 2 = " +
-                 std::to_string(0.5 * gains.stiffness_n_per_mm * period_s) + " N s/mm"};
+                 " is below k T = " + std::to_string(needed) +
+                 " N s/mm (twice the passivity bound k T / 2, which the device needs)"};
   }
   return gains;
 }
@@ -201,16 +204,24 @@ void Simulation::setDevice(std::unique_ptr<haptics::Device> device) {
   device_state_ = device_->read(state_.time);
   pose_ = device_state_.pose;
   coupling_.reset(pose_.tip, device_state_.velocity_mm_s);
+  // The last step's reaction was at the old tool; the new one starts free of it.
+  tool_force_n_.setZero();
+  tool_stiffness_.setZero();
+  hand_force_n_.setZero();
 }
 
 void Simulation::followDevice() {
   device_state_ = device_->read(state_.time + scene_.sim.dt);
   pose_ = device_state_.pose;
-  if (scene_.coupling.mode == CouplingSettings::Mode::Spring) {
-    // The tissue's reaction of the last step, at the proxy where it was then.
-    coupling_.step(device_state_.pose.tip, device_state_.velocity_mm_s, tool_force_n_, tool_stiffness_);
-    pose_.tip = coupling_.proxyTip();
+  if (scene_.coupling.mode != CouplingSettings::Mode::Spring) return;
+  if (!tool_force_n_.allFinite() || !tool_stiffness_.allFinite()) {
+    // A diverged tissue (counted as a warning) must not leave the tool at NaN for good.
+    coupling_.reset(device_state_.pose.tip, device_state_.velocity_mm_s);
+    return;
   }
+  // The tissue's reaction of the last step, at the proxy where it was then.
+  coupling_.step(device_state_.pose.tip, device_state_.velocity_mm_s, tool_force_n_, tool_stiffness_);
+  pose_.tip = coupling_.proxyTip();
 }
 
 haptics::LocalForceModel Simulation::hapticModel() const {

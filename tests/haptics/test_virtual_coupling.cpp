@@ -63,7 +63,8 @@ TEST(VirtualCoupling, AStiffWallStopsTheProxyWithoutRinging) {
     if (i >= 2) {  // no bounce: straight down to the balance, never past it
       EXPECT_LE(next_depth, previous_depth + 1e-15) << "step " << i;
       EXPECT_GE(next_depth, settled - 1e-15) << "step " << i;
-      // The hand never feels more than the coupling spring stretched over the whole way.
+      // From then on the hand never feels more than the spring stretched over the whole way
+      // (the step into the wall and the one back out add the damper's kick).
       EXPECT_LE(c.handForce(device, Eigen::Vector3d::Zero()).norm(), g.stiffness_n_per_mm * 5.0 + 1e-9);
     }
     previous_depth = next_depth;

@@ -59,7 +59,7 @@ struct RunReport {
   double max_tool_force_n = 0.0;
   std::string coupling = "spring";
   double coupling_stiffness_n_per_mm = 0.0, coupling_damping_n_s_per_mm = 0.0;
-  double max_hand_force_n = 0.0;        // the device's command (the coupling's force)
+  double max_hand_force_n = 0.0;        // the force asked of the device (before its clamp)
   double max_coupling_offset_mm = 0.0;  // simulated tool tip behind the device's tip
   double wall_s = 0.0;
   std::vector<PassRecord> passes;  // shaving passes (cuts), in order

@@ -86,7 +86,7 @@ struct CouplingSettings {
   enum class Mode { Spring, Rigid };
   Mode mode = Mode::Spring;
   double stiffness_n_per_mm = 0.0;  // 0: the device's max_stiffness_n_per_mm
-  double damping_n_s_per_mm = 0.0;  // 0: twice the passivity bound, k * dt
+  double damping_n_s_per_mm = 0.0;  // 0: k T (T the device's period): twice the passivity bound
 };
 
 struct Scene {

@@ -25,7 +25,7 @@ class MirroredDevice final : public Device {
   const DeviceInfo& info() const override { return info_; }
   DeviceState read(double time_s) override;
   void commandForce(const Eigen::Vector3d& force_n) override;
-  const Eigen::Vector3d& lastForce() const override { return last_force_; }
+  const Eigen::Vector3d& lastForce() const override { return last_force_; }  // haptic thread only
 
   // Any thread: the magnitude of the force last commanded, newtons.
   double renderedForceN() const { return rendered_n_.load(std::memory_order_relaxed); }
