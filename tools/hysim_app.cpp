@@ -146,6 +146,99 @@ int lensIndexFor(double deg) {
   return best;
 }
 
+// A key the panel did not take. True: quit.
+bool handleKey(SDL_Keycode key, Panel& panel, tools::AppHaptics& force_feedback) {
+  switch (key) {
+    case SDLK_ESCAPE: return true;
+    case SDLK_SPACE: panel.paused = !panel.paused; break;
+    case SDLK_r: panel.reset_requested = true; break;
+    case SDLK_l: panel.lens_index = (panel.lens_index + 1) % 3; break;
+    case SDLK_m: panel.manual_requested = true; break;
+    case SDLK_x: force_feedback.eStop(); break;
+    case SDLK_f: force_feedback.resetSafety(); break;
+    default: break;
+  }
+  return false;
+}
+
+// The fixed steps due for the wall time since the last frame, within the frame's budget.
+void stepDue(engine::Simulation& sim, Pacer& pacer, StepTimes& step_times, Clock::time_point now, double elapsed) {
+  const int due = pacer.due(elapsed);
+  const Clock::time_point budget_end =
+      now + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(pacer.step_budget_s));
+  for (int i = 0; i < due; ++i) {
+    const Clock::time_point t0 = Clock::now();
+    if (t0 >= budget_end) {
+      pacer.drop(due - i);
+      break;
+    }
+    sim.step();
+    step_times.add(1e6 * seconds(Clock::now() - t0));
+  }
+}
+
+// The panel's controls: pause, reset, speed, lens, manual scope, and the keys.
+void drawControls(Panel& panel) {
+  if (ImGui::Button(panel.paused ? "Resume (Space)" : "Pause (Space)", ImVec2(-1, 0))) {
+    panel.paused = !panel.paused;
+  }
+  if (ImGui::Button("Reset (R)", ImVec2(-1, 0))) panel.reset_requested = true;
+  ImGui::SliderFloat("speed", &panel.speed, 0.05f, 1.0f, "%.2fx");
+  ImGui::Text("lens (L)");
+  for (int i = 0; i < 3; ++i) {
+    char label[16];
+    std::snprintf(label, sizeof(label), "%d deg", kLens[i]);
+    if (i > 0) ImGui::SameLine();
+    ImGui::RadioButton(label, &panel.lens_index, i);
+  }
+  ImGui::Separator();
+  if (ImGui::Checkbox("manual scope (M)", &panel.manual)) {
+    panel.manual = !panel.manual;  // applied (and toggled) at the top of the next frame
+    panel.manual_requested = true;
+  }
+  if (panel.manual) {
+    ImGui::TextDisabled("W/S forward/back, arrows move");
+    ImGui::TextDisabled("A/D yaw, PgUp/PgDn pitch");
+    ImGui::TextDisabled("Q/E loop in/out");
+  } else {
+    ImGui::TextDisabled("scope follows the scene's scripted path");
+  }
+  ImGui::TextDisabled("X: force e-stop, F: reset force");
+  ImGui::TextDisabled("Esc: quit");
+}
+
+// Manual control: a keyboard device takes over from the device's current pose (M toggles);
+// back to the script otherwise. Returns the keyboard device (owned by the simulation) or null.
+haptics::ManualDevice* toggleManual(engine::Simulation& sim, const engine::Scene& scene, Panel& panel) {
+  panel.manual_requested = false;
+  panel.manual = !panel.manual;
+  if (!panel.manual) {
+    sim.setDevice(std::make_unique<haptics::ScriptedDevice>(haptics::Trajectory(scene.tool_path)));
+    return nullptr;
+  }
+  auto* device = new haptics::ManualDevice(sim.deviceState().pose, sim.state().time);
+  sim.setDevice(std::unique_ptr<haptics::Device>(device));
+  return device;
+}
+
+// Scales the rendered scope view into the window right of the panel (panel_w in screen
+// coordinates). Returns the window's height in screen coordinates, for the panel.
+int blitView(render::SdlWindow& window, render::Renderer& renderer, float panel_w) {
+  int dw = 0, dh = 0, ww = 0, wh = 0;
+  window.drawableSize(dw, dh);
+  SDL_GetWindowSize(window.nativeWindow(), &ww, &wh);
+  const float scale = ww > 0 ? static_cast<float>(dw) / static_cast<float>(ww) : 1.0f;
+  const int panel_px = static_cast<int>(panel_w * scale);
+  const int area_w = std::max(dw - panel_px, 1), area_h = std::max(dh, 1);
+  const double fit = std::min(static_cast<double>(area_w) / renderer.width(),
+                              static_cast<double>(area_h) / renderer.height());
+  const int vw = static_cast<int>(renderer.width() * fit);
+  const int vh = static_cast<int>(renderer.height() * fit);
+  window.clear(0.08f, 0.08f, 0.09f);
+  renderer.blitTo(0, panel_px + (area_w - vw) / 2, (area_h - vh) / 2, vw, vh);
+  return wh;
+}
+
 int runApp(const AppArgs& args) {
   const std::string scene_path = args.scene.empty() ? tools::defaultScenePath() : args.scene;
   auto scene = engine::loadScene(scene_path);
@@ -199,16 +292,7 @@ int runApp(const AppArgs& args) {
         quit = true;
       }
       if (event.type == SDL_KEYDOWN && !taken && event.key.repeat == 0) {
-        switch (event.key.keysym.sym) {
-          case SDLK_ESCAPE: quit = true; break;
-          case SDLK_SPACE: panel.paused = !panel.paused; break;
-          case SDLK_r: panel.reset_requested = true; break;
-          case SDLK_l: panel.lens_index = (panel.lens_index + 1) % 3; break;
-          case SDLK_m: panel.manual_requested = true; break;
-          case SDLK_x: force_feedback.eStop(); break;
-          case SDLK_f: force_feedback.resetSafety(); break;
-          default: break;
-        }
+        if (handleKey(event.key.keysym.sym, panel, force_feedback)) quit = true;
       }
     }
 
@@ -230,36 +314,14 @@ int runApp(const AppArgs& args) {
       max_force_n = 0.0;
     }
 
-    // Manual control: a keyboard device takes over from the current pose (M toggles).
-    if (panel.manual_requested) {
-      panel.manual_requested = false;
-      panel.manual = !panel.manual;
-      if (panel.manual) {
-        manual_device = new haptics::ManualDevice(sim->deviceState().pose, sim->state().time);
-        sim->setDevice(std::unique_ptr<haptics::Device>(manual_device));
-      } else {
-        manual_device = nullptr;
-        sim->setDevice(std::make_unique<haptics::ScriptedDevice>(haptics::Trajectory(scene->tool_path)));
-      }
-    }
+    if (panel.manual_requested) manual_device = toggleManual(*sim, *scene, panel);
     if (manual_device != nullptr) manual_device->setCommand(keyboardCommand(panel.pedal));
 
     // Fixed steps due for the wall time since the last frame.
     const double sim_before = sim->state().time;
     if (!panel.paused) {
       pacer.speed = panel.speed;
-      const int due = pacer.due(elapsed);
-      const Clock::time_point budget_end =
-          now + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(pacer.step_budget_s));
-      for (int i = 0; i < due; ++i) {
-        const Clock::time_point t0 = Clock::now();
-        if (t0 >= budget_end) {
-          pacer.drop(due - i);
-          break;
-        }
-        sim->step();
-        step_times.add(1e6 * seconds(Clock::now() - t0));
-      }
+      stepDue(*sim, pacer, step_times, now, elapsed);
     }
     force_feedback.publish(*sim);
     const double tool_force_n = sim->toolForceN().norm();
@@ -275,19 +337,8 @@ int runApp(const AppArgs& args) {
     snapshot.camera.lens_deg = static_cast<float>(kLens[panel.lens_index]);
     (*renderer)->draw(snapshot);
 
-    int dw = 0, dh = 0, ww = 0, wh = 0;
-    (*window)->drawableSize(dw, dh);
-    SDL_GetWindowSize((*window)->nativeWindow(), &ww, &wh);
-    const float scale = ww > 0 ? static_cast<float>(dw) / static_cast<float>(ww) : 1.0f;
     const float panel_w = 300.0f;  // screen coordinates
-    const int panel_px = static_cast<int>(panel_w * scale);
-    const int area_w = std::max(dw - panel_px, 1), area_h = std::max(dh, 1);
-    const double fit = std::min(static_cast<double>(area_w) / (*renderer)->width(),
-                                static_cast<double>(area_h) / (*renderer)->height());
-    const int vw = static_cast<int>((*renderer)->width() * fit);
-    const int vh = static_cast<int>((*renderer)->height() * fit);
-    (*window)->clear(0.08f, 0.08f, 0.09f);
-    (*renderer)->blitTo(0, panel_px + (area_w - vw) / 2, (area_h - vh) / 2, vw, vh);
+    const int wh = blitView(**window, **renderer, panel_w);
 
     // The panel.
     (*layer)->newFrame();
@@ -321,32 +372,7 @@ int runApp(const AppArgs& args) {
     }
     ImGui::Text("tool path    %s", panel.manual ? "manual (keyboard)" : st.time < path_end_s ? "scripted" : "done (holding last pose)");
     ImGui::Separator();
-    if (ImGui::Button(panel.paused ? "Resume (Space)" : "Pause (Space)", ImVec2(-1, 0))) {
-      panel.paused = !panel.paused;
-    }
-    if (ImGui::Button("Reset (R)", ImVec2(-1, 0))) panel.reset_requested = true;
-    ImGui::SliderFloat("speed", &panel.speed, 0.05f, 1.0f, "%.2fx");
-    ImGui::Text("lens (L)");
-    for (int i = 0; i < 3; ++i) {
-      char label[16];
-      std::snprintf(label, sizeof(label), "%d deg", kLens[i]);
-      if (i > 0) ImGui::SameLine();
-      ImGui::RadioButton(label, &panel.lens_index, i);
-    }
-    ImGui::Separator();
-    if (ImGui::Checkbox("manual scope (M)", &panel.manual)) {
-      panel.manual = !panel.manual;  // applied (and toggled) at the top of the next frame
-      panel.manual_requested = true;
-    }
-    if (panel.manual) {
-      ImGui::TextDisabled("W/S forward/back, arrows move");
-      ImGui::TextDisabled("A/D yaw, PgUp/PgDn pitch");
-      ImGui::TextDisabled("Q/E loop in/out");
-    } else {
-      ImGui::TextDisabled("scope follows the scene's scripted path");
-    }
-    ImGui::TextDisabled("X: force e-stop, F: reset force");
-    ImGui::TextDisabled("Esc: quit");
+    drawControls(panel);
     ImGui::End();
     (*layer)->render();
 
