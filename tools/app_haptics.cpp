@@ -15,8 +15,7 @@ AppHaptics::~AppHaptics() { loop_->stop(); }
 
 void AppHaptics::publish(const engine::Simulation& sim) {
   const auto step = static_cast<std::int64_t>(sim.state().steps);
-  if (&sim == last_sim_ && step == last_step_) return;  // nothing new: not a fresh model
-  last_sim_ = &sim;
+  if (step == last_step_) return;  // nothing new (paused): not a fresh model
   last_step_ = step;
   device_->publish(sim.deviceState());
   loop_->publishModel(sim.hapticModel());

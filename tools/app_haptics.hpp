@@ -30,7 +30,6 @@ class AppHaptics {
   haptics::MirroredDevice* device_ = nullptr;  // owned by loop_
   std::unique_ptr<haptics::HapticLoop> loop_;
   std::int64_t last_step_ = -1;
-  const engine::Simulation* last_sim_ = nullptr;
 };
 
 }  // namespace hysim::tools
