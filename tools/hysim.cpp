@@ -19,6 +19,7 @@
 #include "hysim/engine/simulation.hpp"
 #include "hysim/render/renderer.hpp"
 #include "tool_common.hpp"
+#include "cli_accuracy.hpp"
 #include "cli_cut2d.hpp"
 
 namespace fs = std::filesystem;
@@ -212,9 +213,11 @@ int main(int argc, char** argv) {
   stats_cmd->add_flag("--json", stats_json, "Print JSON");
 
   auto cut2d_commands = hysim::tools::addCut2dCommands(app);  // hysim cut, hysim tables
+  auto accuracy_command = hysim::tools::addAccuracyCommand(app);
 
   CLI11_PARSE(app, argc, argv);
   if (auto rc = hysim::tools::runCut2dCommands(*cut2d_commands)) return *rc;
+  if (auto rc = hysim::tools::runAccuracyCommand(*accuracy_command)) return *rc;
   if (*run_cmd) return runCommand(run);
   if (*stats_cmd) return statsCommand(stats_path, stats_json);
   return 1;

@@ -1,0 +1,93 @@
+#include "fields.hpp"
+
+#include <cmath>
+
+#include "hysim/engine/tet_locator.hpp"
+#include "hysim/sim/static_solve.hpp"
+
+namespace hysim::engine::accuracy {
+
+namespace {
+
+Result<sim::Model> staticModel(const AccuracyCase& c, bool hold_indenter, bool gravity) {
+  std::vector<int> fixed = c.fixed;
+  if (hold_indenter) fixed.insert(fixed.end(), c.indenter.begin(), c.indenter.end());
+  sim::ModelOptions options;
+  options.gravity = gravity ? c.gravity : Eigen::Vector3d::Zero();
+  return sim::buildModel(c.mesh, c.materials, fixed, options);
+}
+
+}  // namespace
+
+Result<Eigen::MatrixX3d> springStatic(const AccuracyCase& c, bool gravity) {
+  auto model = staticModel(c, false, gravity);
+  if (!model.ok()) return Error{model.error()};
+  sim::State s = sim::makeState(*model, c.mesh);
+  const sim::StaticSolveResult r = sim::solveStatic(*model, s);
+  if (!r.converged) return Error{c.name + ": the static solve did not converge (residual " + std::to_string(r.residual) + ")"};
+  Eigen::MatrixX3d u = s.x - c.mesh.X;
+  return u;
+}
+
+Result<std::vector<double>> springIndentation(const AccuracyCase& c, const std::vector<double>& depths_mm, bool gravity,
+                                              Eigen::MatrixX3d* last) {
+  auto model = staticModel(c, true, gravity);
+  if (!model.ok()) return Error{model.error()};
+  sim::State s = sim::makeState(*model, c.mesh);
+  std::vector<double> forces;
+  for (double depth : depths_mm) {
+    for (int i : c.indenter) s.x.row(i) = c.mesh.X.row(i) + depth * c.indent_direction.transpose();
+    const sim::StaticSolveResult r = sim::solveStatic(*model, s);
+    if (!r.converged)
+      return Error{c.name + ": the static solve at " + std::to_string(depth) + " mm did not converge (residual " +
+                   std::to_string(r.residual) + ")"};
+    const sim::NodeVectors f = sim::staticForces(*model, s.x, nullptr);
+    double reaction = 0.0;
+    for (int i : c.indenter) reaction -= f.row(i).dot(c.indent_direction.transpose());
+    forces.push_back(reaction);
+  }
+  if (last != nullptr) *last = s.x - c.mesh.X;
+  return forces;
+}
+
+double relativeFieldError(const Eigen::MatrixX3d& a, const Eigen::MatrixX3d& b) {
+  const double nb = b.norm();
+  return nb > 0.0 ? (a - b).norm() / nb : (a - b).norm();
+}
+
+Eigen::MatrixX3d interpolateAtNodes(const cutting::TetMesh& fine, const Eigen::MatrixX3d& fine_u,
+                                    const cutting::TetMesh& coarse) {
+  TetLocator locator;
+  const sim::NodeVectors x = fine.X;
+  locator.build(fine, x, 0.5);
+  Eigen::MatrixX3d u(coarse.numNodes(), 3);
+  for (int i = 0; i < coarse.numNodes(); ++i) {
+    const Eigen::Vector3d p = coarse.X.row(i).transpose();
+    const int t = locator.locate(fine, x, p, 0.0);
+    if (t < 0) {
+      Eigen::Index nearest = 0;
+      (fine.X.rowwise() - p.transpose()).rowwise().squaredNorm().minCoeff(&nearest);
+      u.row(i) = fine_u.row(nearest);
+      continue;
+    }
+    Eigen::Matrix3d A;
+    const Eigen::Vector3d x0 = fine.X.row(fine.T(t, 0)).transpose();
+    for (int k = 0; k < 3; ++k) A.col(k) = fine.X.row(fine.T(t, k + 1)).transpose() - x0;
+    const Eigen::Vector3d w = A.partialPivLu().solve(p - x0);
+    u.row(i) = (1.0 - w.sum()) * fine_u.row(fine.T(t, 0)) + w[0] * fine_u.row(fine.T(t, 1)) +
+               w[1] * fine_u.row(fine.T(t, 2)) + w[2] * fine_u.row(fine.T(t, 3));
+  }
+  return u;
+}
+
+Calibration calibrate(const Eigen::MatrixX3d& u_ms, const Eigen::MatrixX3d& u_fe) {
+  Calibration c;
+  const double mm = (u_ms.array() * u_ms.array()).sum();
+  if (!(mm > 0.0)) return c;
+  const double a = (u_ms.array() * u_fe.array()).sum() / mm;  // u_fe ~ a u_ms
+  c.stiffness_scale = a > 0.0 ? 1.0 / a : 1.0;
+  c.error_after = relativeFieldError(a * u_ms, u_fe);
+  return c;
+}
+
+}  // namespace hysim::engine::accuracy
