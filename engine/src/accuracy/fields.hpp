@@ -1,13 +1,16 @@
 #pragma once
 // Displacement fields of the accuracy study: static solutions of the spring network (R1),
 // comparisons between fields, and the one-number stiffness calibration against R2.
+#include <cstdint>
+#include <vector>
+
 #include "hysim/engine/accuracy/cases.hpp"
 #include "hysim/sim/model.hpp"
 
 namespace hysim::engine::accuracy {
 
 // R1: the spring network's static displacement (#N x 3, mm) under the case's gravity.
-Result<Eigen::MatrixX3d> springStatic(const AccuracyCase& c, bool gravity = true);
+Result<Eigen::MatrixX3d> springStatic(const AccuracyCase& c, bool gravity = true, double tolerance = 1e-9);
 
 // R1 of the indentation: the indenter moved through `depths_mm` in turn (each solve starts
 // from the previous depth's answer), its reaction along the indent direction at each (uN).
@@ -15,8 +18,9 @@ Result<Eigen::MatrixX3d> springStatic(const AccuracyCase& c, bool gravity = true
 Result<std::vector<double>> springIndentation(const AccuracyCase& c, const std::vector<double>& depths_mm, bool gravity,
                                               Eigen::MatrixX3d* last = nullptr);
 
-// RMS(a - b) / RMS(b).
-double relativeFieldError(const Eigen::MatrixX3d& a, const Eigen::MatrixX3d& b);
+// RMS(a - b) / RMS(b); over the rows where `use` is 1 when given.
+double relativeFieldError(const Eigen::MatrixX3d& a, const Eigen::MatrixX3d& b,
+                          const std::vector<std::uint8_t>* use = nullptr);
 
 // The field `fine_u` on `fine` interpolated at `coarse`'s nodes (rest positions): linear in
 // the containing tet, the nearest node's value for a node outside the fine mesh.

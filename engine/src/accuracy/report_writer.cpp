@@ -79,6 +79,24 @@ void indentationTable(std::ostringstream& md, const json& ind) {
   }
 }
 
+void cuttingTable(std::ostringstream& md, const json& cut) {
+  md << "\n### Organ: cutting methods (the same planes through the myoma region; pieces no anchor holds removed)\n\n"
+     << "Uncut: " << cut["initial"]["elements"] << " tets, critical explicit step " << num(cut["initial"]["critical_dt_ms"])
+     << " ms.\n\n| cuts | method | tets | q*_min | min edge mm | critical step ms | vs uncut | substeps at 1 ms | cut ms (all cuts) | volume error | sag error vs exact body |\n"
+     << "|---|---|---|---|---|---|---|---|---|---|---|\n";
+  for (const json& r : cut["rows"]) {
+    md << "| " << r["cuts"] << " | " << r["method"].get<std::string>() << " | ";
+    if (r.contains("error")) {
+      md << "failed: " << r["error"].get<std::string>() << " | | | | | | | | |\n";
+      continue;
+    }
+    md << r["elements"] << " | " << num(r["q_min"]) << " | " << num(r["edge_min_mm"]) << " | " << num(r["critical_dt_ms"])
+       << " | " << num(r["critical_dt_ratio"]) << " | " << r.value("substeps_at_1ms", 0) << " | " << num(r["cut_ms_total"], "%.0f")
+       << " | " << num(r["volume_error"]) << " | " << (r.contains("sag_error_vs_exact_body") ? num(r["sag_error_vs_exact_body"]) : "-")
+       << " |\n";
+  }
+}
+
 std::string markdown(const json& r, const std::vector<std::string>& plots) {
   std::ostringstream md;
   md << "# Speed against error\n\nMachine: " << r["machine"].get<std::string>() << (r["quick"].get<bool>() ? " (quick run)" : "")
@@ -100,6 +118,7 @@ std::string markdown(const json& r, const std::vector<std::string>& plots) {
     indentationTable(md, organ["indentation"]);
     dynamicTable(md, "Organ: sagging from rest under gravity (the scene's drag)", organ["sag"]);
     if (organ.contains("release")) dynamicTable(md, "Organ: released from a 5 mm indentation", organ["release"]);
+    if (organ.contains("cutting")) cuttingTable(md, organ["cutting"]);
   }
   const json& c = r["choice_for_default_scene"];
   md << "\n## For the default scene\n\n"

@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 #include <thread>
 
+#include "cut_methods.hpp"
 #include "fields.hpp"
 #include "hysim/cutting/mesh_io.hpp"
 #include "hysim/engine/accuracy/calculix.hpp"
@@ -305,6 +306,8 @@ json organSection(Context& ctx) {
     release.name = "organ release";
     out["release"] = dynamicSweep(ctx, release, rs, u_sag.ok() ? &u_sag.value() : nullptr);
   }
+  out["cutting"] = cutMethodStudy(*organ, *scene, ctx.options.quick ? std::vector<int>{1, 5} : std::vector<int>{1, 5, 20});
+  ctx.progress("organ: cutting methods", 3.0);
   return out;
 }
 
