@@ -1014,7 +1014,8 @@ Status finishUpdate(Model& model, const cutting::TetMesh& after, const cutting::
   // own estimate (not the previous one carried) with more substeps than allowed. Monotone in
   // lambda (sqrt, the limit and substepsFor are), so topEigenvalue may stop once its Ritz
   // value shows it: the round that follows replaces everything that estimate sets.
-  const bool may_scale = opt.substeps <= 0 && opt.max_substeps > 0;
+  // Implicit Euler takes no substeps: never scaled (as buildModel).
+  const bool may_scale = opt.integrator == Integrator::SymplecticEuler && opt.substeps <= 0 && opt.max_substeps > 0;
   const std::function<bool(double)> scaling_follows = [&](double lambda) {
     const double omega = std::sqrt(lambda);
     if (!rep.global_stability && !(omega >= rep.omega_previous)) return false;  // carried
@@ -1056,7 +1057,7 @@ Status finishUpdate(Model& model, const cutting::TetMesh& after, const cutting::
   estimate(true);
   // Selective mass scaling, as buildModel, on the nodes of the estimate.
   // A carried-over previous estimate is not lowered by mass near the cut: no rounds then.
-  if (opt.substeps <= 0 && opt.max_substeps > 0 && substepsFor(m.critical_dt) > opt.max_substeps && !carried) {
+  if (may_scale && substepsFor(m.critical_dt) > opt.max_substeps && !carried) {
     const StepSprings& st = m.step_springs;
     double target = 0.8 * 2.0 * opt.stability_safety * opt.max_substeps / opt.dt;
     for (int round = 0; round < 4 && substepsFor(m.critical_dt) > opt.max_substeps && !carried; ++round) {

@@ -238,7 +238,11 @@ Result<Model> buildModel(const TetMesh& mesh, const std::vector<Material>& mater
   // cut) must not force thousands of substeps. Nodes whose local frequency bound
   // sqrt(2 sum k / m) exceeds what max_substeps allows get mass until it does not; the
   // added mass is reported. The mass moments change by that amount, at those nodes only.
-  if (options.substeps <= 0 && options.max_substeps > 0 && substepsFor(m.critical_dt) > options.max_substeps) {
+  // Implicit Euler takes no substeps: added mass would only make it heavier (and, through
+  // gravity, sag more), so it is never scaled.
+  const bool may_scale =
+      options.integrator == Integrator::SymplecticEuler && options.substeps <= 0 && options.max_substeps > 0;
+  if (may_scale && substepsFor(m.critical_dt) > options.max_substeps) {
     std::vector<double> k_sum(n, 0.0);
     for (int s = 0; s < ns; ++s) {
       k_sum[m.springs(s, 0)] += m.stiffness[s];
