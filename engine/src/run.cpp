@@ -16,6 +16,16 @@ using Clock = std::chrono::steady_clock;
 
 double usSince(Clock::time_point t0) { return std::chrono::duration<double, std::micro>(Clock::now() - t0).count(); }
 
+// The scene key's spelling of each integrator.
+const char* integratorName(sim::Integrator integrator) {
+  switch (integrator) {
+    case sim::Integrator::SymplecticEuler: return "symplectic_euler";
+    case sim::Integrator::ImplicitEuler: return "implicit_euler";
+    case sim::Integrator::Xpbd: return "xpbd";
+  }
+  return "unknown";
+}
+
 // The numbers of the run that do not change while it runs.
 void describe(const Simulation& sim, RunReport& r) {
   const Scene& scene = sim.scene();
@@ -28,7 +38,7 @@ void describe(const Simulation& sim, RunReport& r) {
   r.anchored = sim.numAnchored();
   r.substeps = sim.model().substeps;
   r.critical_dt = sim.model().critical_dt;
-  r.integrator = scene.sim.integrator == sim::Integrator::ImplicitEuler ? "implicit_euler" : "symplectic_euler";
+  r.integrator = integratorName(scene.sim.integrator);
   r.commit_steps = scene.cut.commit_steps;
   r.cut_mode = scene.cut.mode == CutSettings::Mode::Sync ? "sync" : "async";
   const bool rigid = scene.coupling.mode == CouplingSettings::Mode::Rigid;

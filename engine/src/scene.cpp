@@ -140,7 +140,7 @@ AnchorRegion parseAnchor(const Reader& r, const YAML::Node& n) {
 
 void parseSimulation(const Reader& r, const YAML::Node& n, Scene& scene) {
   r.checkKeys(n, "simulation", {"dt_ms", "steps", "integrator", "substeps", "max_substeps", "implicit_iterations",
-                                "drag_per_s", "gravity_mm_s2", "max_speed_mm_s"});
+                                "xpbd_substeps", "xpbd_iterations", "drag_per_s", "gravity_mm_s2", "max_speed_mm_s"});
   if (n["dt_ms"]) {
     const double dt_ms = r.positive(n["dt_ms"], "dt_ms");
     if (dt_ms > 100.0) r.fail(n["dt_ms"], "'dt_ms' must be at most 100, got " + n["dt_ms"].Scalar());
@@ -151,7 +151,8 @@ void parseSimulation(const Reader& r, const YAML::Node& n, Scene& scene) {
     const std::string s = r.string(n["integrator"], "integrator");
     if (s == "symplectic_euler") scene.sim.integrator = sim::Integrator::SymplecticEuler;
     else if (s == "implicit_euler") scene.sim.integrator = sim::Integrator::ImplicitEuler;
-    else r.fail(n["integrator"], "'integrator' must be symplectic_euler or implicit_euler, got '" + s + "'");
+    else if (s == "xpbd") scene.sim.integrator = sim::Integrator::Xpbd;
+    else r.fail(n["integrator"], "'integrator' must be symplectic_euler, implicit_euler or xpbd, got '" + s + "'");
   }
   if (n["substeps"]) {
     if (n["substeps"].IsScalar() && n["substeps"].Scalar() == "auto") scene.sim.substeps = 0;
@@ -159,6 +160,11 @@ void parseSimulation(const Reader& r, const YAML::Node& n, Scene& scene) {
   }
   if (n["max_substeps"]) scene.sim.max_substeps = r.integer(n["max_substeps"], "max_substeps", 1, 10000);
   if (n["implicit_iterations"]) scene.sim.implicit_iterations = r.integer(n["implicit_iterations"], "implicit_iterations", 1, 1000);
+  if (n["xpbd_substeps"]) {
+    if (n["xpbd_substeps"].IsScalar() && n["xpbd_substeps"].Scalar() == "auto") scene.sim.xpbd_substeps = 0;
+    else scene.sim.xpbd_substeps = r.integer(n["xpbd_substeps"], "xpbd_substeps", 1, 10000);
+  }
+  if (n["xpbd_iterations"]) scene.sim.xpbd_iterations = r.integer(n["xpbd_iterations"], "xpbd_iterations", 1, 1000);
   if (n["drag_per_s"]) scene.sim.drag_per_s = r.nonNegative(n["drag_per_s"], "drag_per_s");
   if (n["gravity_mm_s2"]) scene.sim.gravity = r.vec3(n["gravity_mm_s2"], "gravity_mm_s2");
   if (n["max_speed_mm_s"]) scene.sim.max_speed_mm_s = r.positive(n["max_speed_mm_s"], "max_speed_mm_s");

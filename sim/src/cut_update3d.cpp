@@ -1014,8 +1014,7 @@ Status finishUpdate(Model& model, const cutting::TetMesh& after, const cutting::
   // own estimate (not the previous one carried) with more substeps than allowed. Monotone in
   // lambda (sqrt, the limit and substepsFor are), so topEigenvalue may stop once its Ritz
   // value shows it: the round that follows replaces everything that estimate sets.
-  // Implicit Euler takes no substeps: never scaled (as buildModel).
-  const bool may_scale = opt.integrator == Integrator::SymplecticEuler && opt.substeps <= 0 && opt.max_substeps > 0;
+  const bool may_scale = massScalingApplies(opt);
   const std::function<bool(double)> scaling_follows = [&](double lambda) {
     const double omega = std::sqrt(lambda);
     if (!rep.global_stability && !(omega >= rep.omega_previous)) return false;  // carried
@@ -1057,7 +1056,7 @@ Status finishUpdate(Model& model, const cutting::TetMesh& after, const cutting::
   estimate(true);
   // Selective mass scaling, as buildModel, on the nodes of the estimate.
   // A carried-over previous estimate is not lowered by mass near the cut: no rounds then.
-  if (may_scale && substepsFor(m.critical_dt) > opt.max_substeps && !carried) {
+  if (massScalingApplies(opt) && substepsFor(m.critical_dt) > opt.max_substeps && !carried) {
     const StepSprings& st = m.step_springs;
     double target = 0.8 * 2.0 * opt.stability_safety * opt.max_substeps / opt.dt;
     for (int round = 0; round < 4 && substepsFor(m.critical_dt) > opt.max_substeps && !carried; ++round) {
@@ -1076,9 +1075,9 @@ Status finishUpdate(Model& model, const cutting::TetMesh& after, const cutting::
     }
   }
   rep.stability_ms = msSince(stability_start);
-  m.substeps = opt.substeps > 0 ? opt.substeps : substepsFor(m.critical_dt);
-  if (opt.substeps <= 0 && opt.max_substeps > 0) m.substeps = std::min(m.substeps, opt.max_substeps);
-  m.substep = opt.dt / m.substeps;
+  setSubsteps(m, substepsFor(m.critical_dt));
+  // Only the implicit integrator holds a factorisation; XPBD and symplectic Euler read the
+  // spring arrays directly, so the update above is all they need.
   m.implicit.reset();
   if (opt.integrator == Integrator::ImplicitEuler) {
     auto solver = ImplicitSolver::create(m);

@@ -139,6 +139,10 @@ Result<Model> buildModel(const TetMesh& mesh, const std::vector<Material>& mater
   if (!(options.dt > 0.0) || !std::isfinite(options.dt)) {
     return Error{"dt must be positive, got " + std::to_string(options.dt)};
   }
+  if (options.integrator == Integrator::Xpbd && (options.xpbd_substeps < 0 || options.xpbd_iterations < 1)) {
+    return Error{"xpbd_substeps must be >= 0 and xpbd_iterations >= 1, got " + std::to_string(options.xpbd_substeps) +
+                 " and " + std::to_string(options.xpbd_iterations)};
+  }
   const int nt = mesh.numTets();
   const int n = m.num_nodes;
 
@@ -238,11 +242,7 @@ Result<Model> buildModel(const TetMesh& mesh, const std::vector<Material>& mater
   // cut) must not force thousands of substeps. Nodes whose local frequency bound
   // sqrt(2 sum k / m) exceeds what max_substeps allows get mass until it does not; the
   // added mass is reported. The mass moments change by that amount, at those nodes only.
-  // Implicit Euler takes no substeps: added mass would only make it heavier (and, through
-  // gravity, sag more), so it is never scaled.
-  const bool may_scale =
-      options.integrator == Integrator::SymplecticEuler && options.substeps <= 0 && options.max_substeps > 0;
-  if (may_scale && substepsFor(m.critical_dt) > options.max_substeps) {
+  if (massScalingApplies(options) && substepsFor(m.critical_dt) > options.max_substeps) {
     std::vector<double> k_sum(n, 0.0);
     for (int s = 0; s < ns; ++s) {
       k_sum[m.springs(s, 0)] += m.stiffness[s];
@@ -266,9 +266,7 @@ Result<Model> buildModel(const TetMesh& mesh, const std::vector<Material>& mater
       target *= 0.7;  // the local bound is not the global one: tighten and retry
     }
   }
-  m.substeps = options.substeps > 0 ? options.substeps : substepsFor(m.critical_dt);
-  if (options.substeps <= 0 && options.max_substeps > 0) m.substeps = std::min(m.substeps, options.max_substeps);
-  m.substep = options.dt / m.substeps;
+  setSubsteps(m, substepsFor(m.critical_dt));
 
   if (options.integrator == Integrator::ImplicitEuler) {
     auto solver = ImplicitSolver::create(m);
@@ -294,6 +292,7 @@ void sizeStepArrays(const Model& model, State& state) {
   state.scratch1.resize(n, 3);
   state.scratch2.resize(n, 3);
   state.spring_force.resize(4 * static_cast<size_t>(model.step_springs.size()));  // written by every substep first
+  state.xpbd_lambda.resize(static_cast<size_t>(model.springs.rows()));            // zeroed by every XPBD substep
   state.solve0.resize(n, 3);
   state.solve1.resize(n, 3);
 }

@@ -1,5 +1,7 @@
 #pragma once
-// Pieces of the model build shared by buildModel and the incremental update after a cut.
+// Pieces of the model build shared by buildModel and the incremental update after a cut,
+// and the XPBD step that step() calls.
+#include <algorithm>
 #include <functional>
 #include <vector>
 
@@ -14,6 +16,24 @@ void buildStepSprings(Model& model);
 // Its second part: node_offset sized #N+1 and holding at [i] node i's number of step springs
 // (at [#N] 0), `count` the number of step springs.
 void fillStepSprings(Model& model, int count);
+
+// One fixed step of the XPBD integrator (step_xpbd.cpp), called by step().
+void stepXpbd(const Model& model, State& state, const StepInput& input);
+
+// Whether selective mass scaling may hold the automatic substeps at max_substeps: symplectic
+// Euler's count is automatic and capped. Never for XPBD, which is stable at any substep.
+inline bool massScalingApplies(const ModelOptions& o) {
+  return o.integrator == Integrator::SymplecticEuler && o.substeps <= 0 && o.max_substeps > 0;
+}
+// Model::substeps and substep, given the count symplectic Euler's stability limit asks for.
+// XPBD: options.xpbd_substeps, or that count capped at max_substeps when it is 0.
+inline void setSubsteps(Model& m, int stability_substeps) {
+  const ModelOptions& o = m.options;
+  const int wanted = o.integrator == Integrator::Xpbd ? o.xpbd_substeps : o.substeps;
+  m.substeps = wanted > 0 ? wanted : stability_substeps;
+  if (wanted <= 0 && o.max_substeps > 0) m.substeps = std::min(m.substeps, o.max_substeps);
+  m.substep = o.dt / m.substeps;
+}
 
 // The largest eigenvalue of the symmetric tridiagonal matrix with diagonal `diag` and
 // subdiagonal `sub` (size diag.size() - 1), to a few units in the last place of the matrix's

@@ -6,6 +6,7 @@
 
 #include "hysim/sim/model.hpp"
 #include "implicit_solver.hpp"
+#include "model_internal.hpp"
 
 namespace hysim::sim {
 namespace {
@@ -317,6 +318,8 @@ void step(const Model& model, State& state, const StepInput& input) {
   if (state.diverged) return;
   if (model.options.integrator == Integrator::ImplicitEuler && model.implicit) {
     stepImplicitEuler(model, state, input);
+  } else if (model.options.integrator == Integrator::Xpbd) {
+    stepXpbd(model, state, input);
   } else {
     stepSymplecticEuler(model, state, input);
   }

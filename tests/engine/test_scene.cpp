@@ -126,7 +126,37 @@ TEST(SceneErrors, MissingMeshFile) {
 
 TEST(SceneErrors, UnknownIntegrator) {
   expectError("integrator.yaml", replaceLine(minimalScene(), 8, "  integrator: rk4"), ":8:",
-              "'integrator' must be symplectic_euler or implicit_euler, got 'rk4'");
+              "'integrator' must be symplectic_euler, implicit_euler or xpbd, got 'rk4'");
+}
+
+TEST(Scene, XpbdIntegratorParses) {
+  std::string text = replaceLine(minimalScene(), 8, "  integrator: xpbd\n  xpbd_substeps: 12\n  xpbd_iterations: 2");
+  auto scene = loadScene(writeFile("xpbd.yaml", text));
+  ASSERT_TRUE(scene.ok()) << scene.error();
+  EXPECT_EQ(scene->sim.integrator, sim::Integrator::Xpbd);
+  EXPECT_EQ(scene->sim.xpbd_substeps, 12);
+  EXPECT_EQ(scene->sim.xpbd_iterations, 2);
+  text = replaceLine(minimalScene(), 8, "  integrator: xpbd\n  xpbd_substeps: auto");
+  auto automatic = loadScene(writeFile("xpbd_auto.yaml", text));
+  ASSERT_TRUE(automatic.ok()) << automatic.error();
+  EXPECT_EQ(automatic->sim.xpbd_substeps, 0);
+  EXPECT_EQ(automatic->sim.xpbd_iterations, 1);
+  // The scene runs: the tool moves through the tissue with XPBD steps, no warning.
+  auto sim = Simulation::create(*scene);
+  ASSERT_TRUE(sim.ok()) << sim.error();
+  EXPECT_EQ((*sim)->model().substeps, 12);
+  for (int i = 0; i < 20; ++i) (*sim)->step();
+  EXPECT_EQ((*sim)->state().warnings, 0);
+  EXPECT_TRUE((*sim)->state().x.allFinite());
+}
+
+TEST(SceneErrors, BadXpbdValues) {
+  expectError("xpbd_name.yaml", replaceLine(minimalScene(), 8, "  integrator: XPBD2"), ":8:",
+              "'integrator' must be symplectic_euler, implicit_euler or xpbd, got 'XPBD2'");
+  expectError("xpbd_substeps.yaml", replaceLine(minimalScene(), 8, "  xpbd_substeps: 0"), ":8:",
+              "'xpbd_substeps' must be between 1 and 10000, got 0");
+  expectError("xpbd_iterations.yaml", replaceLine(minimalScene(), 8, "  xpbd_iterations: many"), ":8:",
+              "'xpbd_iterations' must be an integer, got 'many'");
 }
 
 TEST(Scene, CouplingParses) {

@@ -29,15 +29,23 @@ struct Material {
 enum class Integrator {
   SymplecticEuler,  // semi-implicit Euler, explicit springs, `substeps` per step
   ImplicitEuler,    // backward Euler, local/global iterations on a prefactored sparse matrix
+  Xpbd,             // XPBD (Macklin 2016) in small substeps (Macklin 2019): springs as compliant
+                    // distance constraints, Gauss-Seidel; stable for any substep, no factorisation
 };
 
 struct ModelOptions {
   double dt = 1e-3;                            // s, fixed step
   Integrator integrator = Integrator::SymplecticEuler;
   int substeps = 0;                            // symplectic Euler; 0 = choose from the stability limit
-  int max_substeps = 32;                       // automatic substeps never exceed this (mass scaling, see Model)
+  int max_substeps = 32;                       // automatic substeps never exceed this (symplectic: mass scaling)
   double stability_safety = 0.85;               // substep = safety * critical step when automatic
   int implicit_iterations = 8;                 // local/global iterations per implicit step
+  // XPBD substeps per step; 0 = the count symplectic Euler's stability limit asks for (with
+  // stability_safety, capped at max_substeps) but without mass scaling: XPBD is stable at any
+  // substep, fewer only cost accuracy (numerical damping, and springs that act softer by
+  // about (h omega)^2 when the Gauss-Seidel sweeps have not converged).
+  int xpbd_substeps = 0;
+  int xpbd_iterations = 1;                     // Gauss-Seidel sweeps over the springs per XPBD substep
   double drag_per_s = 0.0;                     // alpha: mass-proportional damping (fluid drag), 1/s
   Eigen::Vector3d gravity{0.0, 0.0, -9810.0};  // mm/s^2
   double max_speed_mm_s = 1e5;                 // a node faster than this is numerical trouble
@@ -80,8 +88,8 @@ struct Model {
   std::vector<Material> materials;
 
   ModelOptions options;
-  double substep = 0.0;            // s, symplectic Euler substep (dt / substeps)
-  int substeps = 1;
+  double substep = 0.0;            // s, the integrator's substep (dt / substeps); implicit Euler: unused
+  int substeps = 1;                // symplectic Euler's, or XPBD's (options.xpbd_substeps or its rule)
   double critical_dt = 0.0;        // s, estimated stability limit of symplectic Euler
   double omega_max = 0.0;          // rad/s, estimated highest natural frequency
   double added_mass = 0.0;         // g, added by selective mass scaling to respect max_substeps
@@ -130,6 +138,7 @@ struct State {
   // #M x 4 (x, y, z, 0), rows 32-byte aligned: force of each step spring on its a end (one
   // 32-byte load per incident spring when the forces are summed per node)
   std::vector<double, AlignedAllocator<double>> spring_force;
+  std::vector<double> xpbd_lambda;  // #S: XPBD's accumulated constraint impulse per spring (Model::springs)
   Eigen::MatrixX3d solve0;  // #N x 3 column-major: the sparse triangular solves work in place
   Eigen::MatrixX3d solve1;  // on column-major right-hand sides without temporaries
   std::uint64_t steps = 0;
@@ -141,7 +150,7 @@ struct State {
 struct StepInput {
   const NodeVectors* external_force = nullptr;  // #N x 3 uN (contact), or null
   // Optional: called with the current positions and velocities before each substep's forces
-  // (symplectic Euler; once per step for implicit Euler), to refresh *external_force, e.g.
+  // (symplectic Euler and XPBD; once per step for implicit Euler), to refresh *external_force, e.g.
   // contact that follows the tissue within the step. A plain function pointer: no allocation.
   void (*refresh_external)(void* context, const NodeVectors& x, const NodeVectors& v) = nullptr;
   void* context = nullptr;

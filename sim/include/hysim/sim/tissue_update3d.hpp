@@ -91,7 +91,7 @@ Result<Model> updateModel3D(const Model& before, const cutting::TetMesh& mesh_be
 //    of the same top eigenvalue (max over the nodes of 2 lambda_max(sum_s k_s d_s d_s^T) / m_i)
 //    is below the previous estimate: a Lanczos estimate would be below it too, so the outcome
 //    (the previous estimate carried over) is the same.
-//  - the implicit integrator's factorisation is redone.
+//  - the implicit integrator's factorisation is redone (XPBD and symplectic Euler need none).
 struct CutUpdate3DOptions {
   MassUpdate3DOptions masses;
   int mass_rings = 2;               // rings of neighbours around the touched nodes
