@@ -21,7 +21,8 @@ void fillStepSprings(Model& model, int count);
 void stepXpbd(const Model& model, State& state, const StepInput& input);
 
 // Whether selective mass scaling may hold the automatic substeps at max_substeps: symplectic
-// Euler's count is automatic and capped. Never for XPBD, which is stable at any substep.
+// Euler's count is automatic and capped. Never for implicit Euler (no substeps: the mass would
+// only add weight) or XPBD (stable at any substep).
 inline bool massScalingApplies(const ModelOptions& o) {
   return o.integrator == Integrator::SymplecticEuler && o.substeps <= 0 && o.max_substeps > 0;
 }

@@ -2,12 +2,14 @@
 // forms, the orderings of the integrators' errors, the Bullet peer.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
 #include "hysim/engine/accuracy/calculix.hpp"
 #include "hysim/engine/accuracy/cases.hpp"
 #include "hysim/engine/accuracy/runs.hpp"
+#include "hysim/sim/static_solve.hpp"
 #include "test_dir.hpp"
 
 namespace hysim::engine::accuracy {
@@ -57,9 +59,11 @@ TEST(AccuracyCalculix, QuadraticDeckClampsTheMidNodesOfTheClampedFace) {
   const size_t at = deck.find("*NSET, NSET=FIXED\n");
   ASSERT_NE(at, std::string::npos);
   const std::string set = deck.substr(at + 18, deck.find('*', at + 1) - at - 18);
-  std::istringstream entries(set);
+  std::string numbers = set;
+  std::replace(numbers.begin(), numbers.end(), ',', ' ');
+  std::istringstream entries(numbers);
   int count = 0;
-  for (std::string entry; std::getline(entries, entry, ',');) count += entry.find_first_of("0123456789") != std::string::npos;
+  for (int node; entries >> node;) ++count;
   EXPECT_EQ(count, 9 + 16) << set;
   o.quadratic = false;
   EXPECT_NE(calculixDeck(beam, o).find("TYPE=C3D4"), std::string::npos);
@@ -128,19 +132,25 @@ TEST(AccuracyOrderings, SymplecticErrorFallsAsSubstepsGrow) {
 TEST(AccuracyOrderings, ImplicitEulerConvergesToTheStaticSolution) {
   AccuracyCase beam = beamCase(smallBeam());
   beam.drag_per_s = 40.0;  // settles within the run
+  auto model = caseModel(beam, implicitEuler(1, 5e-3).options);
+  ASSERT_TRUE(model.ok());
+  sim::State rest = sim::makeState(*model, beam.mesh);
+  ASSERT_TRUE(sim::solveStatic(*model, rest).converged);
+  const double sag = (rest.x - beam.mesh.X).norm();
   RunSpec spec;
-  spec.duration_s = 1.0;
+  spec.duration_s = 2.0;
   spec.sample_every_s = 0.05;
-  const Trajectory ref = runTrajectory(beam, implicitEuler(64, 5e-3), spec);
+  // Local/global iterations approach the static solution slowly in the beam's soft bending
+  // mode: more iterations per step, closer after the same time.
   double previous = INFINITY;
-  for (int it : {1, 2, 4, 16}) {
+  for (int it : {1, 4, 16, 64}) {
     const Trajectory t = runTrajectory(beam, implicitEuler(it, 5e-3), spec);
     ASSERT_FALSE(t.diverged);
-    const double e = (t.samples.back() - ref.samples.back()).norm();
-    EXPECT_LE(e, previous) << it << " iterations";
+    const double e = (t.samples.back() - rest.x).norm() / sag;
+    EXPECT_LT(e, previous) << it << " iterations";
     previous = e;
   }
-  EXPECT_LT(previous, 1e-6);
+  EXPECT_LT(previous, 1e-3);
   // 33 ms steps stay bounded.
   const Trajectory slow = runTrajectory(beam, implicitEuler(8, 33e-3), spec);
   EXPECT_FALSE(slow.diverged);
