@@ -89,9 +89,10 @@ void writeStep(std::ostringstream& out, const AccuracyCase& c, const FeOptions& 
     out << "*STEP\n*FREQUENCY\n" << o.frequencies << "\n*BOUNDARY\nFIXED, 1, 3\n*END STEP\n";
     return;
   }
-  // Fixed increments of 1/increments: the indenter's reaction is printed at each depth.
-  out << (o.nlgeom ? "*STEP, NLGEOM, INC=1000\n" : "*STEP, INC=1000\n") << "*STATIC, DIRECT\n" << 1.0 / o.increments
-      << ", 1.0\n";
+  // Increments of at most 1/increments (cut back when a nonlinear one does not converge): the
+  // indenter's reaction is printed at each.
+  out << (o.nlgeom ? "*STEP, NLGEOM, INC=1000\n" : "*STEP, INC=1000\n") << "*STATIC\n" << 1.0 / o.increments
+      << ", 1.0, 1e-5, " << 1.0 / o.increments << "\n";
   if (!c.fixed.empty()) out << "*BOUNDARY\nFIXED, 1, 3\n";
   if (o.hold_indenter && !c.indenter.empty()) {
     out << "*BOUNDARY\n";
@@ -148,7 +149,12 @@ Result<FeSolution> parseCalculixDat(const std::string& text, int num_nodes) {
   while (std::getline(in, line)) {
     ++line_no;
     if (line.find("displacements (vx,vy,vz)") != std::string::npos) { block = Block::Displacements; rows = 0; continue; }
-    if (line.find("total force") != std::string::npos) { block = Block::Total; continue; }
+    if (line.find("total force") != std::string::npos) {
+      block = Block::Total;
+      const size_t at = line.find("time");
+      s.increment_times.push_back(at == std::string::npos ? 1.0 : std::strtod(line.c_str() + at + 4, nullptr));
+      continue;
+    }
     if (line.find("P A R T I C I P A T I O N") != std::string::npos) { block = Block::None; continue; }
     if (line.find("E I G E N V A L U E   O U T P U T") != std::string::npos) { block = Block::Eigen; s.frequencies_hz.clear(); continue; }
     const std::vector<double> v = numbersOf(line);
@@ -192,11 +198,15 @@ Result<FeSolution> solveCalculix(const AccuracyCase& c, const FeOptions& o, cons
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const fs::path dat = fs::path(dir) / (job + ".dat");
   std::ifstream in(dat);
-  if (rc != 0 || !in) return Error{o.program + " failed on " + inp.string() + " (exit " + std::to_string(rc) + "; see " + job + ".log)"};
+  const std::string failed = o.program + " failed on " + inp.string() + " (exit " + std::to_string(rc) + "; see " + job + ".log)";
+  if (!in) return Error{failed};
   std::stringstream text;
   text << in.rdbuf();
   auto s = parseCalculixDat(text.str(), c.mesh.numNodes());
+  // A nonlinear run that diverged part-way still printed the increments it reached.
+  if (rc != 0 && (!s.ok() || s->increment_times.empty())) return Error{failed};
   if (!s.ok()) return Error{dat.string() + ": " + s.error()};
+  s->completed = rc == 0;
   s->seconds = seconds;
   return s;
 }

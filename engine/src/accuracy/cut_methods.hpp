@@ -7,7 +7,7 @@
 
 namespace hysim::engine::accuracy {
 
-// The i-th of the study's cut planes through the myoma region (deterministic).
+// The i-th of the study's cut planes: slices across the organ (deterministic).
 void cutPlane(int i, Eigen::Vector3d& point, Eigen::Vector3d& normal);
 
 // For each method and checkpoint: elements, q*_min, minimum edge, the critical explicit step

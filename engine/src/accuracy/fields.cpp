@@ -97,4 +97,46 @@ Calibration calibrate(const Eigen::MatrixX3d& u_ms, const Eigen::MatrixX3d& u_fe
   return c;
 }
 
+namespace {
+
+double calibrationError(const AccuracyCase& c, const std::vector<double>& scales, const Eigen::MatrixX3d& u_fe, int& solves) {
+  AccuracyCase scaled = c;
+  for (size_t m = 0; m < scaled.materials.size(); ++m) scaled.materials[m].young_modulus_pa *= scales[m];
+  ++solves;
+  auto u = springStatic(scaled);
+  return u.ok() ? relativeFieldError(*u, u_fe) : INFINITY;
+}
+
+}  // namespace
+
+Result<MaterialCalibration> calibratePerMaterial(const AccuracyCase& c, const Eigen::MatrixX3d& u_fe, double start_scale) {
+  MaterialCalibration cal;
+  std::vector<double> scales(c.materials.size(), start_scale);
+  const double phi = 0.5 * (std::sqrt(5.0) - 1.0);
+  for (int round = 0; round < 2; ++round) {
+    for (size_t m = 0; m < scales.size(); ++m) {
+      double lo = std::log(scales[m]) - std::log(3.0), hi = std::log(scales[m]) + std::log(3.0);
+      auto at = [&](double log_s) {
+        std::vector<double> trial = scales;
+        trial[m] = std::exp(log_s);
+        return calibrationError(c, trial, u_fe, cal.solves);
+      };
+      double a = hi - phi * (hi - lo), b = lo + phi * (hi - lo), fa = at(a), fb = at(b);
+      for (int k = 0; k < 8; ++k) {
+        if (fa < fb) {
+          hi = b, b = a, fb = fa, a = hi - phi * (hi - lo), fa = at(a);
+        } else {
+          lo = a, a = b, fa = fb, b = lo + phi * (hi - lo), fb = at(b);
+        }
+      }
+      scales[m] = std::exp(fa < fb ? a : b);
+    }
+  }
+  cal.error_after = calibrationError(c, scales, u_fe, cal.solves);
+  if (!std::isfinite(cal.error_after)) return Error{c.name + ": the calibrated static solve failed"};
+  for (const sim::Material& m : c.materials) cal.labels.push_back(m.label);
+  cal.stiffness_scales = scales;
+  return cal;
+}
+
 }  // namespace hysim::engine::accuracy

@@ -35,4 +35,15 @@ struct Calibration {
 };
 Calibration calibrate(const Eigen::MatrixX3d& u_ms, const Eigen::MatrixX3d& u_fe);
 
+// One stiffness scale per material (E_m times s_m), fitted to u_fe by coordinate golden-section
+// searches on log s_m starting from the one-number fit: in the linear range the network's
+// stiffness is linear in each material's E, so the error is smooth in s.
+struct MaterialCalibration {
+  std::vector<int> labels;
+  std::vector<double> stiffness_scales;
+  double error_after = 0.0;
+  int solves = 0;
+};
+Result<MaterialCalibration> calibratePerMaterial(const AccuracyCase& c, const Eigen::MatrixX3d& u_fe, double start_scale);
+
 }  // namespace hysim::engine::accuracy

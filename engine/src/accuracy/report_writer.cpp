@@ -67,6 +67,17 @@ void feTable(std::ostringstream& md, const json& r2, const char* what) {
   }
 }
 
+void calibrationLine(std::ostringstream& md, const json& c) {
+  if (c.contains("error")) {
+    md << "\nPer-material calibration failed: " << c["error"].get<std::string>() << "\n";
+    return;
+  }
+  md << "\nPer-material calibration against " << c["against"].get<std::string>() << ": error " << num(c["error_before"])
+     << " before, " << num(c["error_after_one_scale"]) << " with one stiffness scale, " << num(c["error_after"]) << " with";
+  for (const json& s : c["scales"]) md << " " << s["material"].get<std::string>() << " x" << num(s["stiffness_scale"]);
+  md << " (" << c["static_solves"] << " static solves).\n";
+}
+
 void indentationTable(std::ostringstream& md, const json& ind) {
   md << "\n### Organ: indentation of the anterior wall (" << ind["indenter_nodes"]
      << " cavity-surface nodes held and pushed into the wall; no gravity)\n\n| depth mm | R1 springs mN | R2 linear mN | R2 nonlinear mN |\n|---|---|---|---|\n";
@@ -80,7 +91,7 @@ void indentationTable(std::ostringstream& md, const json& ind) {
 }
 
 void cuttingTable(std::ostringstream& md, const json& cut) {
-  md << "\n### Organ: cutting methods (the same planes through the myoma region; pieces no anchor holds removed)\n\n"
+  md << "\n### Organ: cutting methods (20 slices 3 mm apart across the organ, tilted a few degrees from each other, cut in a fixed order; pieces no anchor holds removed)\n\n"
      << "Uncut: " << cut["initial"]["elements"] << " tets, critical explicit step " << num(cut["initial"]["critical_dt_ms"])
      << " ms.\n\n| cuts | method | tets | q*_min | min edge mm | critical step ms | vs uncut | substeps at 1 ms | cut ms (all cuts) | volume error | sag error vs exact body |\n"
      << "|---|---|---|---|---|---|---|---|---|---|---|\n";
@@ -91,7 +102,7 @@ void cuttingTable(std::ostringstream& md, const json& cut) {
       continue;
     }
     md << r["elements"] << " | " << num(r["q_min"]) << " | " << num(r["edge_min_mm"]) << " | " << num(r["critical_dt_ms"])
-       << " | " << num(r["critical_dt_ratio"]) << " | " << r.value("substeps_at_1ms", 0) << " | " << num(r["cut_ms_total"], "%.0f")
+       << " | " << num(r["critical_dt_ratio"]) << " | " << num(r["substeps_at_1ms"], "%.0f") << " | " << num(r["cut_ms_total"], "%.0f")
        << " | " << num(r["volume_error"]) << " | " << (r.contains("sag_error_vs_exact_body") ? num(r["sag_error_vs_exact_body"]) : "-")
        << " |\n";
   }
@@ -115,11 +126,16 @@ std::string markdown(const json& r, const std::vector<std::string>& plots) {
     md << "\n## Organ (" << organ["mesh"].get<std::string>() << ")\n\nSag under gravity, static: R1 max "
        << num(organ["static"]["r1"]["max_sag_mm"]) << " mm.\n";
     feTable(md, organ["static"]["r2"], "anterior wall mm");
+    if (organ["static"].contains("per_material_calibration")) calibrationLine(md, organ["static"]["per_material_calibration"]);
     indentationTable(md, organ["indentation"]);
     dynamicTable(md, "Organ: sagging from rest under gravity (the scene's drag)", organ["sag"]);
     if (organ.contains("release")) dynamicTable(md, "Organ: released from a 5 mm indentation", organ["release"]);
     if (organ.contains("cutting")) cuttingTable(md, organ["cutting"]);
   }
+  md << "\nBullet's btSoftBody gets the same nodes, masses, anchors and one link per tet edge, but its link "
+        "stiffness (m_kLST = 1) is the fraction of each link's error removed per solver iteration, not a spring "
+        "constant: how stiff it is depends on the iterations and the step, not on the tissue's E, so no setting of it "
+        "is the same material as ours.\n";
   const json& c = r["choice_for_default_scene"];
   md << "\n## For the default scene\n\n"
      << (c.is_null() ? std::string("No setting came within 5% of R1 on the organ's sag.")

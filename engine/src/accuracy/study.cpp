@@ -234,6 +234,34 @@ json beamSection(Context& ctx) {
   return out;
 }
 
+// The indenter's force (mN) at each depth from ccx's increments: a linear analysis solves once
+// (its force scales with the depth); a nonlinear one is interpolated between its increments,
+// null beyond the last one it reached.
+json forcesAtDepths(const FeSolution& fe, const std::vector<double>& depths, const Eigen::Vector3d& dir, bool nonlinear) {
+  json f = json::array();
+  std::vector<double> t = {0.0}, force = {0.0};
+  for (size_t k = 0; k < fe.indenter_forces.size() && k < fe.increment_times.size(); ++k) {
+    t.push_back(fe.increment_times[k]);
+    force.push_back(fe.indenter_forces[k].dot(dir) * 1e-3);
+  }
+  for (double d : depths) {
+    const double at = d / depths.back();
+    if (!nonlinear && t.size() > 1) {
+      f.push_back(force.back() * at / t.back());
+      continue;
+    }
+    size_t k = 1;
+    while (k < t.size() && t[k] < at - 1e-9) ++k;
+    if (k >= t.size()) {
+      f.push_back(nullptr);
+      continue;
+    }
+    const double w = (at - t[k - 1]) / (t[k] - t[k - 1]);
+    f.push_back(force[k - 1] + w * (force[k] - force[k - 1]));
+  }
+  return f;
+}
+
 json indentationSection(Context& ctx, const AccuracyCase& organ) {
   const std::vector<double> depths = {1, 2, 3, 4, 5};
   json out;
@@ -257,16 +285,33 @@ json indentationSection(Context& ctx, const AccuracyCase& organ) {
     o.indent_mm = depths.back();
     o.increments = static_cast<int>(depths.size());
     auto fe = solveCalculix(no_gravity, o, ctx.ccxDir(), nlgeom ? "indent_nlgeom" : "indent_linear");
-    // A linear analysis solves once, at the full depth: its force scales with the depth.
-    json f = json::array();
-    if (fe.ok() && fe->indenter_forces.size() == depths.size())
-      for (const Eigen::Vector3d& r : fe->indenter_forces) f.push_back(r.dot(organ.indent_direction) * 1e-3);
-    else if (fe.ok() && !fe->indenter_forces.empty())
-      for (double d : depths) f.push_back(fe->indenter_forces.back().dot(organ.indent_direction) * 1e-3 * d / depths.back());
+    json f = fe.ok() ? forcesAtDepths(*fe, depths, organ.indent_direction, nlgeom) : json(nullptr);
     out[nlgeom ? "r2_nonlinear_force_mn" : "r2_linear_force_mn"] = fe.ok() ? f : json(fe.error());
   }
   ctx.progress("organ: indentation");
   return out;
+}
+
+// The per-material fit against the C3D10 linear reference on the same mesh.
+json perMaterialCalibration(Context& ctx, const AccuracyCase& organ, const Eigen::MatrixX3d& u_r1) {
+  FeOptions o;
+  o.program = ctx.options.calculix;
+  auto fe = solveCalculix(organ, o, ctx.ccxDir(), "organ_calibration");
+  if (!fe.ok()) return {{"error", fe.error()}};
+  const Calibration one = calibrate(u_r1, fe->u);
+  auto cal = calibratePerMaterial(organ, fe->u, one.stiffness_scale);
+  if (!cal.ok()) return {{"error", cal.error()}};
+  json j;
+  j["against"] = "R2 CalculiX C3D10 linear, same mesh";
+  j["error_before"] = relativeFieldError(u_r1, fe->u);
+  j["error_after_one_scale"] = one.error_after;
+  j["error_after"] = cal->error_after;
+  j["static_solves"] = cal->solves;
+  json scales = json::array();
+  for (size_t m = 0; m < cal->labels.size(); ++m)
+    scales.push_back({{"material", organ.materials[m].name}, {"label", cal->labels[m]}, {"stiffness_scale", cal->stiffness_scales[m]}});
+  j["scales"] = scales;
+  return j;
 }
 
 json organStaticSection(Context& ctx, const AccuracyCase& organ, const Scene& scene) {
@@ -286,6 +331,7 @@ json organStaticSection(Context& ctx, const AccuracyCase& organ, const Scene& sc
     }
   }
   json fe = feReferences(ctx, organ, *u_r1, probe, have_fine ? &fine : nullptr);
+  if (!ctx.options.quick) out["per_material_calibration"] = perMaterialCalibration(ctx, organ, *u_r1);
   out["r2"] = fe;
   ctx.progress("organ: static references");
   return out;

@@ -18,7 +18,8 @@ struct FeOptions {
   bool gravity = true;
   bool hold_indenter = false;  // the case's indenter held, moved indent_mm along its direction
   double indent_mm = 0.0;
-  int increments = 1;          // load steps of equal size (the indenter's force is read at each)
+  int increments = 1;          // at most this many load increments of equal size (nonlinear: ccx
+                               // may take smaller ones); the indenter's force is read at each
   int frequencies = 0;         // > 0: an eigenvalue step instead (the lowest `frequencies` modes)
   std::string program = "ccx";
 };
@@ -26,7 +27,9 @@ struct FeOptions {
 struct FeSolution {
   Eigen::MatrixX3d u;                     // #N x 3 displacements (mm)
   Eigen::Vector3d indenter_force{0, 0, 0};  // total reaction at the indenter nodes (uN), last increment
-  std::vector<Eigen::Vector3d> indenter_forces;  // the same at each increment
+  std::vector<Eigen::Vector3d> indenter_forces;  // the same at each increment...
+  std::vector<double> increment_times;           // ... at these step fractions (0..1]
+  bool completed = true;  // false: ccx stopped early (diverged); the tables hold what it reached
   std::vector<double> frequencies_hz;
   double seconds = 0.0;                   // wall time of the ccx run
 };
