@@ -220,9 +220,10 @@ TEST(Stability, MassScalingRespectsTheSubstepCap) {
 
 TEST(Step, AllocatesNothing) {
   const TetMesh mesh = testing::boxTetMesh(4, 4, 4, 2.0);
-  for (Integrator integrator : {Integrator::SymplecticEuler, Integrator::ImplicitEuler}) {
+  for (Integrator integrator : {Integrator::SymplecticEuler, Integrator::ImplicitEuler, Integrator::Xpbd}) {
     ModelOptions o;
     o.integrator = integrator;
+    o.xpbd_iterations = 2;
     auto model = buildModel(mesh, {tissue()}, {0, 1, 2, 3, 4}, o);
     ASSERT_TRUE(model.ok());
     State s = makeState(*model, mesh);

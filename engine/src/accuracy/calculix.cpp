@@ -92,7 +92,7 @@ void writeStep(std::ostringstream& out, const AccuracyCase& c, const FeOptions& 
   // Increments of at most 1/increments (cut back when a nonlinear one does not converge): the
   // indenter's reaction is printed at each.
   out << (o.nlgeom ? "*STEP, NLGEOM, INC=1000\n" : "*STEP, INC=1000\n") << "*STATIC\n" << 1.0 / o.increments
-      << ", 1.0, 1e-5, " << 1.0 / o.increments << "\n";
+      << ", 1.0, 1e-3, " << 1.0 / o.increments << "\n";
   if (!c.fixed.empty()) out << "*BOUNDARY\nFIXED, 1, 3\n";
   if (o.hold_indenter && !c.indenter.empty()) {
     out << "*BOUNDARY\n";
