@@ -40,7 +40,9 @@ std::optional<int> runAccuracyCommand(const AccuracyCommand& c) {
   o.out_dir = c.out;
   o.quick = c.quick;
   o.scene_path = c.scene.empty() ? std::string(HYSIM_SOURCE_DIR) + "/scenes/default.yaml" : c.scene;
-  o.refined_mesh = c.refined_mesh.empty() ? std::string(HYSIM_SOURCE_DIR) + "/tests/data/cutting/uterus_20k.msh" : c.refined_mesh;
+  // The finer mesh of the default organ serves only the default organ.
+  if (!c.refined_mesh.empty()) o.refined_mesh = c.refined_mesh;
+  else if (c.scene.empty()) o.refined_mesh = std::string(HYSIM_SOURCE_DIR) + "/tests/data/cutting/uterus_20k.msh";
   if (!c.quiet) o.progress = progressBar;
   const Status s = engine::accuracy::runAccuracyStudy(o);
   if (!s.ok()) {

@@ -123,7 +123,7 @@ TEST(AccuracyOrderings, SymplecticErrorFallsAsSubstepsGrow) {
     previous = e;
   }
   EXPECT_LT(previous, 0.01);
-  // Half the automatic substeps is past the stability limit: caught, never NaN.
+  // A third of the automatic substeps is past the stability limit: caught, never NaN.
   const Trajectory unstable = runTrajectory(beam, symplectic(std::max(1, n / 3)), spec);
   EXPECT_TRUE(unstable.diverged);
   EXPECT_TRUE(std::isinf(trajectoryError(unstable, ref, beam.mesh.X)));

@@ -22,7 +22,8 @@ struct BulletPeer::World {
   }
 };
 
-BulletPeer::BulletPeer(const AccuracyCase& c, const sim::Model& model, const BulletOptions& options)
+BulletPeer::BulletPeer(const AccuracyCase& c, const sim::Model& model, const BulletOptions& options,
+                       const sim::NodeVectors* start)
     : world_(std::make_unique<World>()), options_(options) {
   World& w = *world_;
   btSoftBodyWorldInfo& info = w.world.getWorldInfo();
@@ -43,7 +44,14 @@ BulletPeer::BulletPeer(const AccuracyCase& c, const sim::Model& model, const Bul
   mat->m_kLST = static_cast<btScalar>(options.link_stiffness);
   for (int s = 0; s < model.springs.rows(); ++s) w.body->appendLink(model.springs(s, 0), model.springs(s, 1), mat);
   w.body->m_cfg.piterations = options.position_iterations;
-  w.body->m_cfg.kDP = static_cast<btScalar>(options.damping);
+  w.body->m_cfg.kDP = static_cast<btScalar>(1.0 - 1.0 / (1.0 + options.dt * options.drag_per_s));
+  if (start != nullptr) {
+    for (int i = 0; i < n; ++i) {
+      const btVector3 p((*start)(i, 0), (*start)(i, 1), (*start)(i, 2));
+      w.body->m_nodes[i].m_x = p;
+      w.body->m_nodes[i].m_q = p;
+    }
+  }
   w.body->m_cfg.collisions = 0;  // no contacts in these cases
   w.world.addSoftBody(w.body);
 }

@@ -86,7 +86,7 @@ void writeMaterials(std::ostringstream& out, const AccuracyCase& c, double poiss
 
 void writeStep(std::ostringstream& out, const AccuracyCase& c, const FeOptions& o) {
   if (o.frequencies > 0) {
-    out << "*STEP\n*FREQUENCY\n" << o.frequencies << "\n*BOUNDARY\nFIXED, 1, 3\n*END STEP\n";
+    out << "*STEP\n*FREQUENCY\n" << o.frequencies << "\n" << (c.fixed.empty() ? "" : "*BOUNDARY\nFIXED, 1, 3\n") << "*END STEP\n";
     return;
   }
   // Increments of at most 1/increments (cut back when a nonlinear one does not converge): the
@@ -102,7 +102,8 @@ void writeStep(std::ostringstream& out, const AccuracyCase& c, const FeOptions& 
   if (o.gravity && g > 0.0) {
     out << "*DLOAD\n";
     for (const sim::Material& m : c.materials)
-      out << "M" << m.label << ", GRAV, " << g << ", " << c.gravity.x() / g << ", " << c.gravity.y() / g << ", "
+      if ((c.mesh.material.array() == m.label).any())  // only element sets the deck has
+        out << "M" << m.label << ", GRAV, " << g << ", " << c.gravity.x() / g << ", " << c.gravity.y() / g << ", "
           << c.gravity.z() / g << "\n";
   }
   out << "*NODE PRINT, NSET=NALL\nU\n";
@@ -192,11 +193,12 @@ Result<FeSolution> solveCalculix(const AccuracyCase& c, const FeOptions& o, cons
     out << calculixDeck(c, o);
     if (!out) return Error{inp.string() + ": cannot write the CalculiX deck"};
   }
+  const fs::path dat = fs::path(dir) / (job + ".dat");
+  fs::remove(dat, ec);  // a failed run must not leave an earlier run's results to be read
   const auto t0 = std::chrono::steady_clock::now();
-  const std::string cmd = "cd '" + dir + "' && OMP_NUM_THREADS=1 " + o.program + " -i " + job + " > " + job + ".log 2>&1";
+  const std::string cmd = "cd '" + dir + "' && OMP_NUM_THREADS=1 '" + o.program + "' -i '" + job + "' > '" + job + ".log' 2>&1";
   const int rc = std::system(cmd.c_str());
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  const fs::path dat = fs::path(dir) / (job + ".dat");
   std::ifstream in(dat);
   const std::string failed = o.program + " failed on " + inp.string() + " (exit " + std::to_string(rc) + "; see " + job + ".log)";
   if (!in) return Error{failed};

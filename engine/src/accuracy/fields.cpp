@@ -14,6 +14,7 @@ Result<sim::Model> staticModel(const AccuracyCase& c, bool hold_indenter, bool g
   if (hold_indenter) fixed.insert(fixed.end(), c.indenter.begin(), c.indenter.end());
   sim::ModelOptions options;
   options.gravity = gravity ? c.gravity : Eigen::Vector3d::Zero();
+  options.max_substeps = 0;  // no mass scaling: added mass would add weight to the statics
   return sim::buildModel(c.mesh, c.materials, fixed, options);
 }
 
@@ -100,11 +101,23 @@ Calibration calibrate(const Eigen::MatrixX3d& u_ms, const Eigen::MatrixX3d& u_fe
 namespace {
 
 double calibrationError(const AccuracyCase& c, const std::vector<double>& scales, const Eigen::MatrixX3d& u_fe, int& solves) {
+  // A material with no tets in the mesh changes nothing: it keeps scale 1 (see the caller).
   AccuracyCase scaled = c;
   for (size_t m = 0; m < scaled.materials.size(); ++m) scaled.materials[m].young_modulus_pa *= scales[m];
   ++solves;
   auto u = springStatic(scaled);
   return u.ok() ? relativeFieldError(*u, u_fe) : INFINITY;
+}
+
+// The calibration error with material m's scale set to exp(log_s), the others as they are.
+double errorWithScale(const AccuracyCase& c, std::vector<double> scales, size_t m, double log_s,
+                      const Eigen::MatrixX3d& u_fe, int& solves) {
+  scales[m] = std::exp(log_s);
+  return calibrationError(c, scales, u_fe, solves);
+}
+
+bool materialUsed(const AccuracyCase& c, int label) {
+  return (c.mesh.material.array() == label).any();
 }
 
 }  // namespace
@@ -116,17 +129,14 @@ Result<MaterialCalibration> calibratePerMaterial(const AccuracyCase& c, const Ei
   for (int round = 0; round < 2; ++round) {
     for (size_t m = 0; m < scales.size(); ++m) {
       double lo = std::log(scales[m]) - std::log(3.0), hi = std::log(scales[m]) + std::log(3.0);
-      auto at = [&](double log_s) {
-        std::vector<double> trial = scales;
-        trial[m] = std::exp(log_s);
-        return calibrationError(c, trial, u_fe, cal.solves);
-      };
-      double a = hi - phi * (hi - lo), b = lo + phi * (hi - lo), fa = at(a), fb = at(b);
+      if (!materialUsed(c, c.materials[m].label)) continue;
+      double a = hi - phi * (hi - lo), b = lo + phi * (hi - lo);
+      double fa = errorWithScale(c, scales, m, a, u_fe, cal.solves), fb = errorWithScale(c, scales, m, b, u_fe, cal.solves);
       for (int k = 0; k < 8; ++k) {
         if (fa < fb) {
-          hi = b, b = a, fb = fa, a = hi - phi * (hi - lo), fa = at(a);
+          hi = b, b = a, fb = fa, a = hi - phi * (hi - lo), fa = errorWithScale(c, scales, m, a, u_fe, cal.solves);
         } else {
-          lo = a, a = b, fa = fb, b = lo + phi * (hi - lo), fb = at(b);
+          lo = a, a = b, fa = fb, b = lo + phi * (hi - lo), fb = errorWithScale(c, scales, m, b, u_fe, cal.solves);
         }
       }
       scales[m] = std::exp(fa < fb ? a : b);

@@ -27,6 +27,9 @@ Status writeAtomically(const fs::path& path, const std::string& text) {
   return {};
 }
 
+// j[key], or null when j is not an object or has no such key (a section that failed).
+json at(const json& j, const char* key) { return j.is_object() && j.contains(key) ? j[key] : json(); }
+
 std::string num(const json& v, const char* fmt = "%.3g") {
   if (!v.is_number()) return "-";
   char buf[64];
@@ -38,17 +41,17 @@ const char* kFamilies[] = {"symplectic_euler", "implicit_euler", "xpbd", "bullet
 
 void dynamicTable(std::ostringstream& md, const std::string& title, const json& sweep) {
   if (!sweep.contains("runs")) return;
-  md << "\n### " << title << "\n\n" << sweep["nodes"] << " nodes, " << sweep["tets"] << " tets, " << num(sweep["duration_s"])
+  md << "\n### " << title << "\n\n" << sweep["nodes"] << " nodes, " << sweep["tets"] << " tets, " << num(at(sweep, "duration_s"))
      << " s simulated. Reference " << sweep["reference"].get<std::string>() << " (halving its substep again moves it by "
-     << num(sweep["reference_self_check"]) << "); its probe oscillates at " << num(sweep["reference_frequency_hz"]) << " Hz.\n\n"
+     << num(at(sweep, "reference_self_check")) << "); its probe oscillates at " << num(at(sweep, "reference_frequency_hz")) << " Hz.\n\n"
      << "| setting | dt ms | substeps | iterations | error vs R1 | at the end vs R1 static | median ms/s | p99 ms/s | probe Hz | amplitude ratio | energy change | Pareto |\n"
      << "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const json& r : sweep["runs"]) {
-    md << "| " << r["label"].get<std::string>() << " | " << num(r["dt_ms"]) << " | " << r["substeps"] << " | " << r["iterations"]
-       << " | " << (r["diverged"].get<bool>() ? std::string("diverged") : num(r["error_vs_r1"])) << " | "
-       << (r.contains("final_error_vs_r1_static") ? num(r["final_error_vs_r1_static"]) : std::string("-")) << " | "
-       << num(r["median_ms_per_s"], "%.1f") << " | " << num(r["p99_ms_per_s"], "%.1f") << " | " << num(r["frequency_hz"])
-       << " | " << num(r["amplitude_ratio"]) << " | " << num(r["energy_change"]) << " | " << (r.value("pareto", false) ? "yes" : "")
+    md << "| " << r["label"].get<std::string>() << " | " << num(at(r, "dt_ms")) << " | " << r["substeps"] << " | " << r["iterations"]
+       << " | " << (r["diverged"].get<bool>() ? std::string("diverged") : num(at(r, "error_vs_r1"))) << " | "
+       << (r.contains("final_error_vs_r1_static") ? num(at(r, "final_error_vs_r1_static")) : std::string("-")) << " | "
+       << num(at(r, "median_ms_per_s"), "%.1f") << " | " << num(at(r, "p99_ms_per_s"), "%.1f") << " | " << num(at(r, "frequency_hz"))
+       << " | " << num(at(r, "amplitude_ratio")) << " | " << num(at(r, "energy_change")) << " | " << (r.value("pareto", false) ? "yes" : "")
        << " |\n";
   }
 }
@@ -61,9 +64,9 @@ void feTable(std::ostringstream& md, const json& r2, const char* what) {
       md << "| " << f["name"].get<std::string>() << " | failed: " << f["error"].get<std::string>() << " | | | | | |\n";
       continue;
     }
-    md << "| " << f["name"].get<std::string>() << " | " << num(f["probe_displacement_mm"]) << " | "
-       << num(f["max_displacement_mm"]) << " | " << num(f["spring_error_vs_this"]) << " | " << num(f["calibration_stiffness_scale"]) << " | "
-       << num(f["spring_error_after_calibration"]) << " | " << num(f["ccx_seconds"], "%.1f") << " |\n";
+    md << "| " << f["name"].get<std::string>() << " | " << num(at(f, "probe_displacement_mm")) << " | "
+       << num(at(f, "max_displacement_mm")) << " | " << num(at(f, "spring_error_vs_this")) << " | " << num(at(f, "calibration_stiffness_scale")) << " | "
+       << num(at(f, "spring_error_after_calibration")) << " | " << num(at(f, "ccx_seconds"), "%.1f") << " |\n";
   }
 }
 
@@ -72,9 +75,9 @@ void calibrationLine(std::ostringstream& md, const json& c) {
     md << "\nPer-material calibration failed: " << c["error"].get<std::string>() << "\n";
     return;
   }
-  md << "\nPer-material calibration against " << c["against"].get<std::string>() << ": error " << num(c["error_before"])
-     << " before, " << num(c["error_after_one_scale"]) << " with one stiffness scale, " << num(c["error_after"]) << " with";
-  for (const json& s : c["scales"]) md << " " << s["material"].get<std::string>() << " x" << num(s["stiffness_scale"]);
+  md << "\nPer-material calibration against " << c["against"].get<std::string>() << ": error " << num(at(c, "error_before"))
+     << " before, " << num(at(c, "error_after_one_scale")) << " with one stiffness scale, " << num(at(c, "error_after")) << " with";
+  for (const json& s : c["scales"]) md << " " << s["material"].get<std::string>() << " x" << num(at(s, "stiffness_scale"));
   md << " (" << c["static_solves"] << " static solves).\n";
 }
 
@@ -82,17 +85,17 @@ void indentationTable(std::ostringstream& md, const json& ind) {
   md << "\n### Organ: indentation of the anterior wall (" << ind["indenter_nodes"]
      << " cavity-surface nodes held and pushed into the wall; no gravity)\n\n| depth mm | R1 springs mN | R2 linear mN | R2 nonlinear mN |\n|---|---|---|---|\n";
   for (size_t k = 0; k < ind["depth_mm"].size(); ++k) {
-    auto at = [&](const char* key) {
+    auto cell = [&](const char* key) {
       return ind.contains(key) && ind[key].is_array() && k < ind[key].size() ? num(ind[key][k]) : std::string("-");
     };
-    md << "| " << num(ind["depth_mm"][k]) << " | " << at("r1_force_mn") << " | " << at("r2_linear_force_mn") << " | "
-       << at("r2_nonlinear_force_mn") << " |\n";
+    md << "| " << num(at(ind, "depth_mm")[k]) << " | " << cell("r1_force_mn") << " | " << cell("r2_linear_force_mn") << " | "
+       << cell("r2_nonlinear_force_mn") << " |\n";
   }
 }
 
 void cuttingTable(std::ostringstream& md, const json& cut) {
   md << "\n### Organ: cutting methods (20 slices 3 mm apart across the organ, tilted a few degrees from each other, cut in a fixed order; pieces no anchor holds removed)\n\n"
-     << "Uncut: " << cut["initial"]["elements"] << " tets, critical explicit step " << num(cut["initial"]["critical_dt_ms"])
+     << "Uncut: " << cut["initial"]["elements"] << " tets, critical explicit step " << num(at(at(cut, "initial"), "critical_dt_ms"))
      << " ms.\n\n| cuts | method | tets | q*_min | min edge mm | critical step ms | vs uncut | substeps at 1 ms | cut ms (all cuts) | volume error | sag error vs exact body |\n"
      << "|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const json& r : cut["rows"]) {
@@ -101,9 +104,9 @@ void cuttingTable(std::ostringstream& md, const json& cut) {
       md << "failed: " << r["error"].get<std::string>() << " | | | | | | | | |\n";
       continue;
     }
-    md << r["elements"] << " | " << num(r["q_min"]) << " | " << num(r["edge_min_mm"]) << " | " << num(r["critical_dt_ms"])
-       << " | " << num(r["critical_dt_ratio"]) << " | " << num(r["substeps_at_1ms"], "%.0f") << " | " << num(r["cut_ms_total"], "%.0f")
-       << " | " << num(r["volume_error"]) << " | " << (r.contains("sag_error_vs_exact_body") ? num(r["sag_error_vs_exact_body"]) : "-")
+    md << r["elements"] << " | " << num(at(r, "q_min")) << " | " << num(at(r, "edge_min_mm")) << " | " << num(at(r, "critical_dt_ms"))
+       << " | " << num(at(r, "critical_dt_ratio")) << " | " << num(at(r, "substeps_at_1ms"), "%.0f") << " | " << num(at(r, "cut_ms_total"), "%.0f")
+       << " | " << num(at(r, "volume_error")) << " | " << (r.contains("sag_error_vs_exact_body") ? num(at(r, "sag_error_vs_exact_body")) : "-")
        << " |\n";
   }
 }
@@ -114,17 +117,17 @@ std::string markdown(const json& r, const std::vector<std::string>& plots) {
      << ".\n\n" << r["units"].get<std::string>() << ". R1: the same spring network converged (Newton static solve; "
      << "symplectic Euler at a small substep in time). R2: CalculiX, linear tets, Poisson's ratio 0.45. R3: Euler-Bernoulli.\n";
   const json& beam = r["beam"];
-  if (beam.contains("r3")) {
-    md << "\n## Beam (cantilever under its own weight)\n\nTip sag: R3 " << num(beam["r3"]["tip_sag_mm"]) << " mm, R1 (springs) "
-       << num(beam["r1"]["tip_sag_mm"]) << " mm. First frequency: R3 " << num(beam["r3"]["first_frequency_hz"]) << " Hz, R2 "
-       << num(beam["r2_first_frequency_hz"]) << " Hz, springs " << num(beam["dynamic"]["reference_frequency_hz"]) << " Hz.\n";
+  if (beam.contains("r3") && beam.contains("r2")) {
+    md << "\n## Beam (cantilever under its own weight)\n\nTip sag: R3 " << num(at(at(beam, "r3"), "tip_sag_mm")) << " mm, R1 (springs) "
+       << num(at(at(beam, "r1"), "tip_sag_mm")) << " mm. First frequency: R3 " << num(at(at(beam, "r3"), "first_frequency_hz")) << " Hz, R2 "
+       << num(at(beam, "r2_first_frequency_hz")) << " Hz, springs " << num(at(at(beam, "dynamic"), "reference_frequency_hz")) << " Hz.\n";
     feTable(md, beam["r2"], "tip sag mm");
     dynamicTable(md, "Beam: released from rest under gravity (undamped)", beam["dynamic"]);
   }
   const json& organ = r["organ"];
-  if (organ.contains("static")) {
+  if (organ.contains("static") && organ["static"].contains("r2")) {
     md << "\n## Organ (" << organ["mesh"].get<std::string>() << ")\n\nSag under gravity, static: R1 max "
-       << num(organ["static"]["r1"]["max_sag_mm"]) << " mm.\n";
+       << num(at(at(at(organ, "static"), "r1"), "max_sag_mm")) << " mm.\n";
     feTable(md, organ["static"]["r2"], "anterior wall mm");
     if (organ["static"].contains("per_material_calibration")) calibrationLine(md, organ["static"]["per_material_calibration"]);
     indentationTable(md, organ["indentation"]);
@@ -140,8 +143,8 @@ std::string markdown(const json& r, const std::vector<std::string>& plots) {
   md << "\n## For the default scene\n\n"
      << (c.is_null() ? std::string("No setting came within 5% of R1 on the organ's sag.")
                      : "The cheapest setting within 5% of R1 on the organ's sag (so within 5% of what the spring network "
-                       "can reach against R2): **" + c["label"].get<std::string>() + "**, " + num(c["median_ms_per_s"], "%.1f") +
-                           " ms per simulated second, error " + num(c["error_vs_r1"]) + ".")
+                       "can reach against R2): **" + c["label"].get<std::string>() + "**, " + num(at(c, "median_ms_per_s"), "%.1f") +
+                           " ms per simulated second, error " + num(at(c, "error_vs_r1")) + ".")
      << "\n";
   if (!plots.empty()) md << "\n## Plots\n\n";
   for (const std::string& p : plots) md << "![" << p << "](" << p << ")\n";

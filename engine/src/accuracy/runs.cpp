@@ -54,7 +54,9 @@ Trajectory runBullet(const AccuracyCase& c, const Setting& setting, const RunSpe
     return t;
   }
   t.dt = setting.bullet_options.dt;
-  BulletPeer peer(c, *model, setting.bullet_options);
+  BulletOptions bo = setting.bullet_options;
+  bo.drag_per_s = c.drag_per_s;
+  BulletPeer peer(c, *model, bo, spec.start);
   const Recorder rec = makeRecorder(c, spec, t.dt);
   const long steps = std::lround(spec.duration_s / t.dt);
   sim::NodeVectors x;
@@ -112,11 +114,12 @@ Trajectory runTrajectory(const AccuracyCase& c, const Setting& setting, const Ru
 }
 
 double trajectoryError(const Trajectory& run, const Trajectory& ref, const cutting::Positions& rest) {
-  if (run.diverged || run.samples.empty()) return std::numeric_limits<double>::infinity();
+  const double inf = std::numeric_limits<double>::infinity();
+  if (run.diverged || ref.diverged || run.samples.empty() || run.samples.size() != ref.samples.size()) return inf;
   double worst = 0.0, scale = 0.0;
-  const size_t n = std::min(run.samples.size(), ref.samples.size());
-  for (size_t k = 0; k < n; ++k) {
-    worst = std::max(worst, rms(run.samples[k], ref.samples[k]));
+  for (size_t k = 0; k < run.samples.size(); ++k) {
+    const double e = rms(run.samples[k], ref.samples[k]);
+    if (!(e <= worst)) worst = std::isfinite(e) ? e : inf;
     scale = std::max(scale, rms(ref.samples[k], rest));
   }
   return scale > 0.0 ? worst / scale : worst;

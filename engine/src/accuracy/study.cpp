@@ -5,7 +5,6 @@
 #include <fstream>
 #include <limits>
 #include <nlohmann/json.hpp>
-#include <thread>
 
 #include "cut_methods.hpp"
 #include "fields.hpp"
@@ -224,7 +223,7 @@ json beamSection(Context& ctx) {
   freq.frequencies = 1;
   auto f = solveCalculix(beam, freq, ctx.ccxDir(), "beam_frequency");
   out["r2_first_frequency_hz"] = f.ok() && !f->frequencies_hz.empty() ? json(f->frequencies_hz[0]) : json(nullptr);
-  for (auto& j : fe) j["tip_sag_mm"] = j.value("probe_displacement_mm", 0.0);
+  for (auto& j : fe) j["tip_sag_mm"] = j.contains("probe_displacement_mm") ? j["probe_displacement_mm"] : json(nullptr);
   out["r2"] = fe;
   ctx.progress("beam: references");
   AccuracyCase dyn = beam;  // released from rest under gravity, undamped: oscillates about the sag
@@ -328,6 +327,8 @@ json organStaticSection(Context& ctx, const AccuracyCase& organ, const Scene& sc
       fine.mesh = std::move(mesh.value());
       fine.fixed = anchoredNodes(scene, fine.mesh);
       have_fine = true;
+    } else {
+      out["refined_mesh_error"] = mesh.error();
     }
   }
   json fe = feReferences(ctx, organ, *u_r1, probe, have_fine ? &fine : nullptr);

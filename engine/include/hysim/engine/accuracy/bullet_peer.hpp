@@ -15,13 +15,15 @@ struct BulletOptions {
   double dt = 1e-3;            // s
   int position_iterations = 4; // btSoftBody::Config::piterations
   double link_stiffness = 1.0; // Material::m_kLST in [0, 1]
-  double damping = 0.0;        // Config::kDP in [0, 1]
+  double drag_per_s = 0.0;     // the case's drag, as Config::kDP = 1 - 1 / (1 + dt drag)
 };
 
 class BulletPeer {
  public:
-  // `mass` and `fixed` per node, as the spring model has them (so masses match exactly).
-  BulletPeer(const AccuracyCase& c, const sim::Model& model, const BulletOptions& options);
+  // `mass` and `fixed` per node, as the spring model has them (so masses match exactly); the
+  // links' rest lengths from the mesh, the nodes then moved to `start` when given.
+  BulletPeer(const AccuracyCase& c, const sim::Model& model, const BulletOptions& options,
+             const sim::NodeVectors* start = nullptr);
   ~BulletPeer();
   BulletPeer(const BulletPeer&) = delete;
   BulletPeer& operator=(const BulletPeer&) = delete;

@@ -34,7 +34,7 @@ struct FeSolution {
   double seconds = 0.0;                   // wall time of the ccx run
 };
 
-// The deck text (nodes, C3D4 elements per material, anchored and indenter sets, one step).
+// The deck text (nodes, elements per material, anchored and indenter sets, one step).
 std::string calculixDeck(const AccuracyCase& c, const FeOptions& options);
 
 // Parses a `.dat` file's last displacement table, last total-force line and eigenvalue table.

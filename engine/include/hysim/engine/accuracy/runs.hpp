@@ -22,7 +22,6 @@ struct RunSpec {
   double duration_s = 0.4;
   double sample_every_s = 0.08;          // a multiple of every setting's dt
   const sim::NodeVectors* start = nullptr;  // start positions (at rest when null: the mesh)
-  bool release_indenter = true;          // the indenter's nodes are free in the run
 };
 
 struct Trajectory {
@@ -43,7 +42,7 @@ Result<sim::Model> caseModel(const AccuracyCase& c, sim::ModelOptions options);
 Trajectory runTrajectory(const AccuracyCase& c, const Setting& setting, const RunSpec& spec);
 
 // max over samples of RMS(x - x_ref) / max over samples of RMS(x_ref - rest); infinity when
-// the run diverged.
+// either run diverged or their samples differ in number.
 double trajectoryError(const Trajectory& run, const Trajectory& reference, const cutting::Positions& rest);
 
 // Median and 99th percentile of the steps' wall time, as milliseconds per simulated second.
