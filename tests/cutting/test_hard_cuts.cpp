@@ -111,11 +111,10 @@ double criticalRatioAfterCuts(CutMethod method, const std::vector<std::pair<Vec3
   return criticalStep(mesh) / initial;
 }
 
-// The hybrid keeps the critical step within a factor ~2 of the fresh bar's (measured 0.44:
-// snaps may shorten an edge to min_edge_fraction = 0.3 of its length and a Van Gelder spring
-// stiffens as 1/|e|^2, so the 0.5 hoped for is not what the defaults give; the loss happens in
-// the first six cuts and stays), while standard subdivision's drops below 0.1 (measured 0.017:
-// a 0.01 mm edge in the first cut). The gap between them, not a tuned threshold, is the point.
+// The hybrid keeps the critical step within a factor ~2 of the fresh bar's (snaps may shorten
+// an edge to min_edge_fraction = 0.3 of its length and a Van Gelder spring stiffens as
+// 1/|e|^2, so the 0.5 hoped for is not what the defaults give), while standard subdivision's
+// drops below 0.1 (slivers from the first cut on). The gap between them is the point.
 TEST(HardCuts, TwentyCutsKeepTheCriticalStepHybridButNotStandard) {
   const auto planes = parallelPlanes(20);
   double q_hybrid = 0, q_standard = 0;

@@ -249,8 +249,8 @@ Eigen::Vector3d pushedThroughNearestFace(const TetMesh& mesh, int node, double f
 // An interior node pushed just through (1.2x) and far through (2.5x) the nearest opposite face
 // of its tets. Springs cannot see orientation; the step must stay finite: recover (no warning,
 // bounded) or report divergence and freeze, never NaN in x or v. Implicit Euler recovers;
-// symplectic Euler diverges (caught): its substep comes from the rest shape's frequencies, and
-// springs squeezed towards zero length stiffen far beyond them (already at 0.6x, uninverted).
+// symplectic Euler may diverge (and is caught): its substep comes from the rest shape's
+// frequencies, and springs squeezed towards zero length stiffen far beyond them.
 TEST(HardInverted, NodePushedThroughItsOppositeFaceNeverGivesNaN) {
   const TetMesh mesh = testing::boxTetMesh(3, 3, 3, 1.0);
   const int node = (1 * 4 + 1) * 4 + 1;  // interior node (1, 1, 1)
