@@ -29,6 +29,18 @@ struct DeviceState {
   std::uint32_t buttons = 0;                       // bit i = button i pressed
 };
 
+// What a device driver counts while it runs (reported by `hysim run`): packets of a network
+// bridge, disconnects of a pad. Devices with nothing to count leave it zero.
+struct DeviceCounters {
+  long packets_received = 0;  // well-formed state packets taken
+  long packets_lost = 0;      // sequence numbers skipped
+  long packets_late = 0;      // arrived after a newer one (reordered or duplicated): dropped
+  long packets_malformed = 0; // wrong size, magic, version or non-finite values: dropped
+  long stale_periods = 0;     // times the input went silent for longer than the device's timeout
+  long disconnects = 0;       // the device went away (unplugged, peer silent)
+  long reconnects = 0;
+};
+
 class Device {
  public:
   virtual ~Device() = default;
@@ -41,6 +53,10 @@ class Device {
   virtual void commandForce(const Eigen::Vector3d& force_n) = 0;
   // The force last sent after clamping (for reports and tests).
   virtual const Eigen::Vector3d& lastForce() const = 0;
+  // Whether the device is there and delivering input now (a pad unplugged or a silent network
+  // peer: false, the tool frozen); and its counters. Any thread.
+  virtual bool connected() const { return true; }
+  virtual DeviceCounters counters() const { return {}; }
 };
 
 // Clamps a force to max_n (keeping its direction); non-finite input gives zero.
