@@ -150,8 +150,27 @@ std::string reportJson(const RunReport& r) {
   j["perforation_events"] = events;
   j["chips"] = {{"mode", r.chips_mode}, {"in_cavity", r.chips_in_cavity}, {"left_cavity", r.chips_left_cavity},
                 {"over_cap", r.chips_over_cap}, {"step_us_mean", r.chip_step_us_mean}};
+  const haptics::DeviceCounters& c = r.device_counters;
+  j["device"] = {{"name", r.device},
+                 {"connected", r.device_connected},
+                 {"packets_received", c.packets_received},
+                 {"packets_lost", c.packets_lost},
+                 {"packets_late", c.packets_late},
+                 {"packets_malformed", c.packets_malformed},
+                 {"stale_periods", c.stale_periods},
+                 {"disconnects", c.disconnects},
+                 {"reconnects", c.reconnects}};
+  if (!r.recording.empty()) {
+    j["recording"] = {{"file", r.recording}, {"states", r.recording_states}, {"replay", r.replay}};
+    if (r.replay) {
+      j["recording"]["scene_hash_recorded"] = hashHex(r.recorded_scene_hash);
+      j["recording"]["scene_hash_now"] = hashHex(r.scene_hash_now);
+      j["recording"]["scene_changed"] = r.replay_scene_changed;
+    }
+  }
   j["per_pass"] = per_pass;
-  return j.dump(2) + "\n";
+  // Names from devices and scenes may hold bytes that are not UTF-8: replaced, not fatal.
+  return j.dump(2, ' ', false, nlohmann::ordered_json::error_handler_t::replace) + "\n";
 }
 
 }  // namespace hysim::engine

@@ -51,6 +51,9 @@ void describe(const Simulation& sim, RunReport& r) {
 void collect(const Simulation& sim, RunReport& r) {
   const Scene& scene = sim.scene();
   r.state_hash = sim.stateHash();
+  r.device = sim.device().info().name;
+  r.device_connected = sim.device().connected();
+  r.device_counters = sim.device().counters();
   r.warnings = sim.state().warnings;
   r.passes = sim.passes();
   r.initial_myoma_mm3 = sim.initialMyomaVolume();
@@ -140,6 +143,7 @@ Result<RunReport> run(Simulation& sim, const RunOptions& options) {
       pace.sleepUntilNs(due);
       late_us.push_back(static_cast<double>(pace.nowNs() - due) / 1000.0);
     }
+    if (options.before_step) options.before_step(sim, i);
     const auto t0 = Clock::now();
     sim.step();
     step_us.push_back(usSince(t0));

@@ -202,6 +202,7 @@ Result<std::unique_ptr<Simulation>> Simulation::create(const Scene& scene) {
 void Simulation::setDevice(std::unique_ptr<haptics::Device> device) {
   device_ = std::move(device);
   device_state_ = device_->read(state_.time);
+  if (recorder_ != nullptr) recorder_->append(device_state_, true);
   pose_ = device_state_.pose;
   coupling_.reset(pose_.tip, device_state_.velocity_mm_s);
   // The last step's reaction was at the old tool; the new one starts free of it.
@@ -210,8 +211,19 @@ void Simulation::setDevice(std::unique_ptr<haptics::Device> device) {
   hand_force_n_.setZero();
 }
 
+Status Simulation::recordInputTo(haptics::RecordingWriter* writer) {
+  if (writer != nullptr && state_.steps != 0) {
+    return Error{"a recording starts before the first step (this simulation has taken " +
+                 std::to_string(state_.steps) + ")"};
+  }
+  recorder_ = writer;
+  if (recorder_ != nullptr) recorder_->append(device_state_, true);
+  return Status::Ok();
+}
+
 void Simulation::followDevice() {
   device_state_ = device_->read(state_.time + scene_.sim.dt);
+  if (recorder_ != nullptr) recorder_->append(device_state_, false);
   pose_ = device_state_.pose;
   if (scene_.coupling.mode != CouplingSettings::Mode::Spring) return;
   if (!tool_force_n_.allFinite() || !tool_stiffness_.allFinite()) {

@@ -20,6 +20,8 @@ struct RunOptions {
   // Pace each step to start dt after the previous one on the wall clock (absolute sleeps),
   // with a HapticLoop at 1 kHz driving a simulated device (the scene's script).
   bool realtime = false;
+  // Called before each step (step counts from 0): a replay attaches recorded devices here.
+  std::function<void(Simulation&, int step)> before_step;
 };
 
 // Median, 99th percentile and maximum of a set of samples (0 when empty).
@@ -62,6 +64,17 @@ struct RunReport {
   double max_hand_force_n = 0.0;        // the force asked of the device (before its clamp)
   double max_coupling_offset_mm = 0.0;  // simulated tool tip behind the device's tip
   double wall_s = 0.0;
+  // The device that drove the tool at the end of the run, and what its driver counted.
+  std::string device;
+  bool device_connected = true;
+  haptics::DeviceCounters device_counters;
+  // Recording (hysim run --record) or replay (hysim replay): the file, its states, and for a
+  // replay the scene's content hash then and now (they differ only when forced).
+  std::string recording;
+  std::uint64_t recording_states = 0;
+  bool replay = false;
+  std::uint64_t recorded_scene_hash = 0, scene_hash_now = 0;
+  bool replay_scene_changed = false;
   std::vector<PassRecord> passes;  // shaving passes (cuts), in order
   double initial_myoma_mm3 = 0.0;
   double electrode_active_s = 0.0;

@@ -21,6 +21,7 @@
 #include "hysim/engine/tool.hpp"
 #include "hysim/haptics/device.hpp"
 #include "hysim/haptics/local_force_model.hpp"
+#include "hysim/haptics/recording.hpp"
 #include "hysim/haptics/virtual_coupling.hpp"
 #include "hysim/render/snapshot.hpp"
 #include "hysim/sim/model.hpp"
@@ -64,6 +65,11 @@ class Simulation {
   // Replaces the device that drives the tool (e.g. a keyboard device in the trainee app); the
   // coupling's proxy starts on its tip.
   void setDevice(std::unique_ptr<haptics::Device> device);
+  // Records every device state the simulation consumes from now on into `writer` (the
+  // current one first, as an attach; then one per step and one per setDevice), or stops
+  // recording (null). Only before the first step, where a replay starts. The writer must
+  // outlive the recording.
+  Status recordInputTo(haptics::RecordingWriter* writer);
   int numAnchored() const { return tissue_->num_anchored; }
   int numDeformableTets() const { return tissue_->num_deformable_tets; }  // tets with at least one free node
   int numSurfaceNodes() const { return static_cast<int>(tissue_->surface_nodes.size()); }
@@ -167,6 +173,7 @@ class Simulation {
   std::unique_ptr<Tissue> tissue_;  // the epoch being stepped
   sim::State state_;
   std::unique_ptr<haptics::Device> device_;  // the scene's scripted device unless replaced
+  haptics::RecordingWriter* recorder_ = nullptr;  // see recordInputTo
   haptics::DeviceState device_state_;
   haptics::VirtualCoupling coupling_{haptics::CouplingGains{}, 1e-3};
   haptics::ToolPose pose_;
