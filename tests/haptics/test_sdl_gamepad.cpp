@@ -250,6 +250,28 @@ TEST_F(SdlGamepad, ClosingTheDeviceStopsTheMotors) {
   EXPECT_EQ(pad_->lastRumble().high, 0);
 }
 
+// The same pad read as a raw joystick when the mapping says so, with a mapping's own gain.
+TEST(SdlGamepadRaw, JoystickLayoutMappingReadsRawAxesWithItsGain) {
+  auto pad = VirtualPad::attach("hysim raw pad");
+  ASSERT_TRUE(pad.ok()) << "SDL's virtual joystick is needed for this test: " << pad.error();
+  auto mapping = parseGamepadMapping("layout: joystick\nadvance: { gain: 20 }\n", "raw.yaml");
+  ASSERT_TRUE(mapping.ok()) << mapping.error();
+  SdlGamepadOptions options;
+  options.device_index = (*pad)->deviceIndex();
+  options.mapping = *mapping;
+  auto device = SdlGamepadDevice::open(ToolPose{}, 0.0, options);
+  ASSERT_TRUE(device.ok()) << device.error();
+  EXPECT_FALSE((*device)->isController());
+  EXPECT_EQ((*device)->mapping().advance.gain, 20.0);
+  (*pad)->setStick(1, -1.0);  // raw axis 1, up
+  (*pad)->setButton(0, true); // raw button 0: the pedal
+  (*device)->read(0.0);
+  const DeviceState s = (*device)->read(0.5);
+  EXPECT_NEAR(s.pose.tip.z(), 10.0, 1e-9);
+  EXPECT_TRUE(s.pose.pedal);
+  device->reset();
+}
+
 TEST(SdlGamepadOpen, NoPadAtTheIndexIsAnError) {
   SdlGamepadOptions options;
   options.device_index = 57;
