@@ -20,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "app_gamepad.hpp"
 #include "app_haptics.hpp"
 #include "tool_common.hpp"
 #include "hysim/engine/scene.hpp"
@@ -52,6 +53,7 @@ struct AppArgs {
   int height = 768;
   bool no_vsync = false;
   bool paused = false;
+  tools::GamepadArgs gamepad;
 };
 
 // Median of the last kWindow step times, without allocating per frame.
@@ -207,11 +209,15 @@ void drawControls(Panel& panel) {
   ImGui::TextDisabled("Esc: quit");
 }
 
-// Manual control: a keyboard device takes over from the device's current pose (M toggles);
-// back to the script otherwise. Returns the keyboard device (owned by the simulation) or null.
-haptics::ManualDevice* toggleManual(engine::Simulation& sim, const engine::Scene& scene, Panel& panel) {
+// Manual control: the game controller (when one is used) or else a keyboard device takes over
+// from the device's current pose (M toggles); back to the script otherwise. Returns the
+// keyboard device (owned by the simulation) or null.
+haptics::ManualDevice* toggleManual(engine::Simulation& sim, const engine::Scene& scene, Panel& panel,
+                                    tools::AppGamepad& gamepad) {
   panel.manual_requested = false;
   panel.manual = !panel.manual;
+  gamepad.release();  // whatever comes next replaces the simulation's device
+  if (panel.manual && gamepad.enabled() && gamepad.attach(sim)) return nullptr;
   if (!panel.manual) {
     sim.setDevice(std::make_unique<haptics::ScriptedDevice>(haptics::Trajectory(scene.tool_path)));
     return nullptr;
@@ -239,6 +245,61 @@ int blitView(render::SdlWindow& window, render::Renderer& renderer, float panel_
   return wh;
 }
 
+// The numbers of the frame the panel shows.
+struct FrameNumbers {
+  double step_median_us = 0.0;
+  double realtime = 0.0;
+  double frame_ms = 0.0;
+  double behind_s = 0.0;
+  double tool_force_n = 0.0;
+  double max_force_n = 0.0;
+};
+
+// The panel: what runs, how fast, the forces, the controller, the controls.
+void drawPanel(const engine::Scene& scene, const engine::Simulation& sim, Panel& panel, const FrameNumbers& n,
+               tools::AppHaptics& force_feedback, const tools::AppGamepad& gamepad, double path_end_s,
+               float panel_w, float panel_h) {
+  ImGui::SetNextWindowPos(ImVec2(0, 0));
+  ImGui::SetNextWindowSize(ImVec2(panel_w, panel_h));
+  ImGui::Begin("hysim", nullptr,
+               ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse);
+  ImGui::TextWrapped("%s", scene.description.empty() ? scene.name.c_str() : scene.description.c_str());
+  ImGui::Separator();
+  const sim::State& st = sim.state();
+  if (panel.paused) ImGui::TextColored(ImVec4(0.4f, 0.8f, 1.0f, 1.0f), "PAUSED");
+  ImGui::Text("sim time     %8.3f s", st.time);
+  ImGui::Text("steps        %8llu  (dt %.3g ms)", static_cast<unsigned long long>(st.steps), 1e3 * scene.sim.dt);
+  ImGui::Text("step time    %8.1f us  (median of %d)", n.step_median_us, StepTimes::kWindow);
+  ImGui::Text("substeps     %8d", sim.model().substeps);
+  ImGui::Text("real time    %8.2f x", n.realtime);
+  ImGui::Text("frame        %8.1f ms", n.frame_ms);
+  if (n.behind_s > 0.05) {
+    // The simulation is never skipped ahead: a too slow machine runs in slow motion.
+    ImGui::TextColored(ImVec4(1.0f, 0.75f, 0.3f, 1.0f), "behind real time by %.2f s", n.behind_s);
+  }
+  ImGui::Separator();
+  ImGui::Text("tool force   %8.3f N", n.tool_force_n);
+  ImGui::Text("max force    %8.3f N", n.max_force_n);
+  force_feedback.drawPanel();
+  if (st.warnings > 0) {
+    ImGui::TextColored(ImVec4(1.0f, 0.35f, 0.3f, 1.0f), "warnings     %8d  (numerical trouble)", st.warnings);
+  } else {
+    ImGui::Text("warnings     %8d", st.warnings);
+  }
+  const char* path = gamepad.active() ? "game controller"
+                     : panel.manual   ? "manual (keyboard)"
+                     : st.time < path_end_s ? "scripted"
+                                            : "done (holding last pose)";
+  ImGui::Text("tool path    %s", path);
+  if (gamepad.active()) {
+    ImGui::Separator();
+    gamepad.drawPanel();
+  }
+  ImGui::Separator();
+  drawControls(panel);
+  ImGui::End();
+}
+
 int runApp(const AppArgs& args) {
   const std::string scene_path = args.scene.empty() ? tools::defaultScenePath() : args.scene;
   auto scene = engine::loadScene(scene_path);
@@ -246,6 +307,8 @@ int runApp(const AppArgs& args) {
   auto created = engine::Simulation::create(*scene);
   if (!created.ok()) return fail(created.error());
   std::unique_ptr<engine::Simulation> sim = std::move(created.value());
+  tools::AppGamepad gamepad;  // before the window: a missing pad or a bad mapping file stops here
+  if (Status s = gamepad.configure(args.gamepad); !s.ok()) return fail(s.error());
 
   render::SdlWindowOptions window_options;
   window_options.title = "hysim - " + scene->name;
@@ -275,6 +338,7 @@ int runApp(const AppArgs& args) {
 
   haptics::ManualDevice* manual_device = nullptr;  // owned by the simulation while in use
   tools::AppHaptics force_feedback;
+  panel.manual_requested = gamepad.enabled();  // the pad takes the tool at the first frame
 
   const Clock::time_point start = Clock::now();
   Clock::time_point last = start;
@@ -308,13 +372,16 @@ int runApp(const AppArgs& args) {
       if (!fresh.ok()) return fail("reset: " + fresh.error());
       sim = std::move(fresh.value());
       manual_device = nullptr;  // the fresh simulation follows the script again
+      gamepad.release();        // (the pad's device went with the old simulation)
+      panel.manual_requested = gamepad.enabled();
       panel.manual = false;
       pacer.reset();
       step_times.clear();
       max_force_n = 0.0;
     }
 
-    if (panel.manual_requested) manual_device = toggleManual(*sim, *scene, panel);
+    if (panel.manual_requested) manual_device = toggleManual(*sim, *scene, panel, gamepad);
+    gamepad.update(*sim, scene->safety.perforation_margin_mm, panel.lens_index);
     if (manual_device != nullptr) manual_device->setCommand(keyboardCommand(panel.pedal));
 
     // Fixed steps due for the wall time since the last frame.
@@ -342,38 +409,8 @@ int runApp(const AppArgs& args) {
 
     // The panel.
     (*layer)->newFrame();
-    ImGui::SetNextWindowPos(ImVec2(0, 0));
-    ImGui::SetNextWindowSize(ImVec2(panel_w, static_cast<float>(wh)));
-    ImGui::Begin("hysim", nullptr,
-                 ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse);
-    ImGui::TextWrapped("%s", scene->description.empty() ? scene->name.c_str() : scene->description.c_str());
-    ImGui::Separator();
-    const sim::State& st = sim->state();
-    if (panel.paused) ImGui::TextColored(ImVec4(0.4f, 0.8f, 1.0f, 1.0f), "PAUSED");
-    ImGui::Text("sim time     %8.3f s", st.time);
-    ImGui::Text("steps        %8llu  (dt %.3g ms)", static_cast<unsigned long long>(st.steps),
-                1e3 * scene->sim.dt);
-    ImGui::Text("step time    %8.1f us  (median of %d)", step_times.median(), StepTimes::kWindow);
-    ImGui::Text("substeps     %8d", sim->model().substeps);
-    ImGui::Text("real time    %8.2f x", realtime);
-    ImGui::Text("frame        %8.1f ms", frame_ms);
-    if (pacer.behind_s > 0.05) {
-      // The simulation is never skipped ahead: a too slow machine runs in slow motion.
-      ImGui::TextColored(ImVec4(1.0f, 0.75f, 0.3f, 1.0f), "behind real time by %.2f s", pacer.behind_s);
-    }
-    ImGui::Separator();
-    ImGui::Text("tool force   %8.3f N", tool_force_n);
-    ImGui::Text("max force    %8.3f N", max_force_n);
-    force_feedback.drawPanel();
-    if (st.warnings > 0) {
-      ImGui::TextColored(ImVec4(1.0f, 0.35f, 0.3f, 1.0f), "warnings     %8d  (numerical trouble)", st.warnings);
-    } else {
-      ImGui::Text("warnings     %8d", st.warnings);
-    }
-    ImGui::Text("tool path    %s", panel.manual ? "manual (keyboard)" : st.time < path_end_s ? "scripted" : "done (holding last pose)");
-    ImGui::Separator();
-    drawControls(panel);
-    ImGui::End();
+    FrameNumbers numbers{step_times.median(), realtime, frame_ms, pacer.behind_s, tool_force_n, max_force_n};
+    drawPanel(*scene, *sim, panel, numbers, force_feedback, gamepad, path_end_s, panel_w, static_cast<float>(wh));
     (*layer)->render();
 
     ++frame;
@@ -404,6 +441,14 @@ int main(int argc, char** argv) {
   app.add_option("--height", args.height, "Window height")->check(CLI::Range(240, 16384));
   app.add_flag("--no-vsync", args.no_vsync, "Do not wait for the display's refresh");
   app.add_flag("--paused", args.paused, "Start paused");
+  app.add_flag("--gamepad", args.gamepad.force,
+               "Drive the scope with a game controller (used by default when one is attached)");
+  app.add_flag("--no-gamepad", args.gamepad.disable, "Keyboard only, even when a game controller is attached");
+  app.add_option("--gamepad-mapping", args.gamepad.mapping_file,
+                 "Game controller mapping file (YAML, see haptics/README.md); implies --gamepad")
+      ->check(CLI::ExistingFile);
+  app.add_flag("--virtual-pad", args.gamepad.virtual_pad,
+               "Attach a software game controller (no input; shows the controller panel without a pad)");
   CLI11_PARSE(app, argc, argv);
   return runApp(args);
 }
