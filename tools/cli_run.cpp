@@ -13,6 +13,7 @@
 #include "hysim/engine/simulation.hpp"
 #include "hysim/haptics/recording.hpp"
 #include "hysim/render/renderer.hpp"
+#include "run_device.hpp"
 #include "tool_common.hpp"
 
 namespace fs = std::filesystem;
@@ -130,14 +131,17 @@ int runCommand(const RunArgs& args) {
   const engine::RunOverrides overrides{args.mesh, args.chips};
   if (Status st = engine::applyOverrides(overrides, *scene); !st.ok()) return fail(st.error());
   if (args.sync_cut) scene->cut.mode = engine::CutSettings::Mode::Sync;
+  RunDevice device;  // outlives the simulation, which holds the device's driver
   auto sim = engine::Simulation::create(*scene);
   if (!sim.ok()) return fail(sim.error());
   if (Status st = setUpDebugging(args, **sim); !st.ok()) return fail(st.error());
+  if (Status st = device.attach(args.device, args.gamepad_mapping, **sim); !st.ok()) return fail(st.error());
   std::unique_ptr<render::OffscreenRenderer> renderer;
   engine::RunOptions options;
   options.steps = args.steps;
   options.every = args.every;
   options.realtime = args.realtime;
+  options.before_step = [&device](engine::Simulation& s, int) { device.beforeStep(s); };
   if (Status st = setUpFrames(*scene, args.frames, renderer, options); !st.ok()) return fail(st.error());
   haptics::RecordingWriter recorder;
   if (!args.record.empty()) {
@@ -198,6 +202,12 @@ void addRunOptions(CLI::App& cmd, RunArgs& run) {
   cmd.add_option("--record", run.record,
                  "Record the device states the simulation consumes (one per step) into this file, for "
                  "`hysim replay`");
+  cmd.add_option("--device", run.device,
+                 "What drives the tool: scripted (the scene's tool_path, default), gamepad (the first game "
+                 "controller), virtual-pad:FILE (a software pad playing a timed input script, e.g. "
+                 "scenes/pad/default-course.yaml)");
+  cmd.add_option("--gamepad-mapping", run.gamepad_mapping, "Game controller mapping file (haptics/README.md)")
+      ->check(CLI::ExistingFile);
   cmd.add_flag("--quiet", run.quiet, "Print nothing but errors");
   cmd.add_flag("--realtime", run.realtime,
                "Pace the steps to the wall clock, with the haptic thread (1 kHz) rendering forces on a simulated "

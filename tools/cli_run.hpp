@@ -22,6 +22,8 @@ struct RunArgs {
   bool sync_cut = false;  // cut on the simulation thread (reference mode)
   int cut_delay_ms = 0;   // debugging: the worker sleeps a random 0..N ms before each cut
   std::string record;     // write the consumed device states to this file
+  std::string device;     // see run_device.hpp; empty: the scene's script
+  std::string gamepad_mapping;
 };
 
 struct ReplayArgs {

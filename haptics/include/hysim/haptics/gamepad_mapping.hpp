@@ -6,6 +6,7 @@
 #include <array>
 #include <cstdint>
 #include <string>
+#include <string_view>
 
 #include "hysim/cutting/result.hpp"
 #include "hysim/haptics/device.hpp"
@@ -22,6 +23,11 @@ enum Button : int {
   kDpadUp, kDpadDown, kDpadLeft, kDpadRight, kNumButtons
 };
 }  // namespace pad
+
+// The standard layout's input names ("left_y", "right_trigger"; "a", "right_shoulder"), as
+// mapping files write them: the index, or -1 for a name that is not one.
+int padAxisIndex(std::string_view name);
+int padButtonIndex(std::string_view name);
 
 inline constexpr int kMaxPadAxes = 16;     // raw joysticks beyond this are read up to it
 inline constexpr int kMaxPadButtons = 32;  // buttons fit one bit each

@@ -36,6 +36,20 @@ AxisBinding stick(int axis, double gain, bool invert) {
 
 }  // namespace
 
+int padAxisIndex(std::string_view name) {
+  for (int i = 0; i < pad::kNumAxes; ++i) {
+    if (kAxisNames[i] == name) return i;
+  }
+  return -1;
+}
+
+int padButtonIndex(std::string_view name) {
+  for (int i = 0; i < pad::kNumButtons; ++i) {
+    if (kButtonNames[i] == name) return i;
+  }
+  return -1;
+}
+
 GamepadMapping defaultControllerMapping() {
   GamepadMapping m;
   m.name = "default controller";
@@ -175,9 +189,9 @@ int MappingReader::input(const YAML::Node& n, const std::string& key, bool is_ax
   if (s == "none") return -1;
   if (layout == PadLayout::Controller) {
     if (is_axis) {
-      for (int i = 0; i < pad::kNumAxes; ++i) if (kAxisNames[i] == s) return i;
+      if (const int i = padAxisIndex(s); i >= 0) return i;
     } else {
-      for (int i = 0; i < pad::kNumButtons; ++i) if (kButtonNames[i] == s) return i;
+      if (const int i = padButtonIndex(s); i >= 0) return i;
     }
   }
   const int limit = is_axis ? kMaxPadAxes : kMaxPadButtons;
