@@ -135,6 +135,7 @@ int runCommand(const RunArgs& args) {
   auto sim = engine::Simulation::create(*scene);
   if (!sim.ok()) return fail(sim.error());
   if (Status st = setUpDebugging(args, **sim); !st.ok()) return fail(st.error());
+  device.setWaitSeconds(args.device_wait_s);
   if (Status st = device.attach(args.device, args.gamepad_mapping, **sim); !st.ok()) return fail(st.error());
   std::unique_ptr<render::OffscreenRenderer> renderer;
   engine::RunOptions options;
@@ -205,7 +206,9 @@ void addRunOptions(CLI::App& cmd, RunArgs& run) {
   cmd.add_option("--device", run.device,
                  "What drives the tool: scripted (the scene's tool_path, default), gamepad (the first game "
                  "controller), virtual-pad:FILE (a software pad playing a timed input script, e.g. "
-                 "scenes/pad/default-course.yaml)");
+                 "scenes/pad/default-course.yaml), udp:PORT (a device bridge on 127.0.0.1:PORT, e.g. hysim-udp-peer)");
+  cmd.add_option("--device-wait-s", run.device_wait_s, "udp: seconds to wait for the bridge's first packet")
+      ->check(CLI::Range(0.0, 3600.0));
   cmd.add_option("--gamepad-mapping", run.gamepad_mapping, "Game controller mapping file (haptics/README.md)")
       ->check(CLI::ExistingFile);
   cmd.add_flag("--quiet", run.quiet, "Print nothing but errors");

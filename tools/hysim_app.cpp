@@ -20,7 +20,9 @@
 #include <string>
 #include <vector>
 
+#include "hysim/engine/run.hpp"
 #include "app_gamepad.hpp"
+#include "app_recording.hpp"
 #include "app_haptics.hpp"
 #include "tool_common.hpp"
 #include "hysim/engine/scene.hpp"
@@ -54,6 +56,7 @@ struct AppArgs {
   bool no_vsync = false;
   bool paused = false;
   tools::GamepadArgs gamepad;
+  std::string record;  // the session's recording; empty: a new file in the recordings folder
 };
 
 // Median of the last kWindow step times, without allocating per frame.
@@ -257,8 +260,8 @@ struct FrameNumbers {
 
 // The panel: what runs, how fast, the forces, the controller, the controls.
 void drawPanel(const engine::Scene& scene, const engine::Simulation& sim, Panel& panel, const FrameNumbers& n,
-               tools::AppHaptics& force_feedback, const tools::AppGamepad& gamepad, double path_end_s,
-               float panel_w, float panel_h) {
+               tools::AppHaptics& force_feedback, const tools::AppGamepad& gamepad,
+               const tools::AppRecording& recording, double path_end_s, float panel_w, float panel_h) {
   ImGui::SetNextWindowPos(ImVec2(0, 0));
   ImGui::SetNextWindowSize(ImVec2(panel_w, panel_h));
   ImGui::Begin("hysim", nullptr,
@@ -295,6 +298,7 @@ void drawPanel(const engine::Scene& scene, const engine::Simulation& sim, Panel&
     ImGui::Separator();
     gamepad.drawPanel();
   }
+  recording.drawPanel();
   ImGui::Separator();
   drawControls(panel);
   ImGui::End();
@@ -338,6 +342,8 @@ int runApp(const AppArgs& args) {
 
   haptics::ManualDevice* manual_device = nullptr;  // owned by the simulation while in use
   tools::AppHaptics force_feedback;
+  tools::AppRecording recording;
+  recording.start(*scene, *sim, args.record);
   panel.manual_requested = gamepad.enabled();  // the pad takes the tool at the first frame
 
   const Clock::time_point start = Clock::now();
@@ -370,7 +376,9 @@ int runApp(const AppArgs& args) {
       panel.reset_requested = false;
       auto fresh = engine::Simulation::create(*scene);
       if (!fresh.ok()) return fail("reset: " + fresh.error());
+      recording.finish();  // a reset starts a new session, recorded anew
       sim = std::move(fresh.value());
+      recording.start(*scene, *sim);
       manual_device = nullptr;  // the fresh simulation follows the script again
       gamepad.release();        // (the pad's device went with the old simulation)
       panel.manual_requested = gamepad.enabled();
@@ -410,7 +418,8 @@ int runApp(const AppArgs& args) {
     // The panel.
     (*layer)->newFrame();
     FrameNumbers numbers{step_times.median(), realtime, frame_ms, pacer.behind_s, tool_force_n, max_force_n};
-    drawPanel(*scene, *sim, panel, numbers, force_feedback, gamepad, path_end_s, panel_w, static_cast<float>(wh));
+    drawPanel(*scene, *sim, panel, numbers, force_feedback, gamepad, recording, path_end_s, panel_w,
+              static_cast<float>(wh));
     (*layer)->render();
 
     ++frame;
@@ -422,8 +431,10 @@ int runApp(const AppArgs& args) {
     (*window)->swapBuffers();
     if (quit) break;
   }
-  std::printf("hysim-app: %ld frames, sim time %.3f s, %llu steps, warnings %d\n", frame, sim->state().time,
-              static_cast<unsigned long long>(sim->state().steps), sim->state().warnings);
+  recording.finish();
+  std::printf("hysim-app: %ld frames, sim time %.3f s, %llu steps, warnings %d, state_hash %s\n", frame,
+              sim->state().time, static_cast<unsigned long long>(sim->state().steps), sim->state().warnings,
+              engine::hashHex(sim->stateHash()).c_str());
   return 0;
 }
 
@@ -449,6 +460,9 @@ int main(int argc, char** argv) {
       ->check(CLI::ExistingFile);
   app.add_flag("--virtual-pad", args.gamepad.virtual_pad,
                "Attach a software game controller (no input; shows the controller panel without a pad)");
+  app.add_option("--record", args.record,
+                 "Record the session into this file (default: a new file in the recordings folder, "
+                 "$HYSIM_DATA_DIR or ~/.local/share/hysim, /recordings)");
   CLI11_PARSE(app, argc, argv);
   return runApp(args);
 }

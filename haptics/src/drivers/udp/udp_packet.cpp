@@ -1,5 +1,7 @@
 #include "hysim/haptics/udp_packet.hpp"
 
+#include "hysim/haptics/little_endian.hpp"
+
 #include <Eigen/Geometry>
 #include <bit>
 #include <cassert>
@@ -23,17 +25,19 @@ class Writer {
   void bytes(const std::array<std::uint8_t, 4>& b) {
     for (std::uint8_t v : b) out_[at_++] = v;
   }
-  void u16(std::uint16_t v) { unsigned_le(v, 2); }
-  void u32(std::uint32_t v) { unsigned_le(v, 4); }
-  void f64(double v) { unsigned_le(std::bit_cast<std::uint64_t>(v), 8); }
+  void u16(std::uint16_t v) { le::putU16(next(2), v); }
+  void u32(std::uint32_t v) { le::putU32(next(4), v); }
+  void f64(double v) { le::putF64(next(8), v); }
   void vec3(const Eigen::Vector3d& v) {
     for (int i = 0; i < 3; ++i) f64(v[i]);
   }
   std::size_t offset() const { return at_; }
 
  private:
-  void unsigned_le(std::uint64_t v, int n) {
-    for (int i = 0; i < n; ++i) out_[at_++] = static_cast<std::uint8_t>(v >> (8 * i));
+  unsigned char* next(std::size_t n) {
+    unsigned char* p = out_.data() + at_;
+    at_ += n;
+    return p;
   }
   std::span<std::uint8_t> out_;
   std::size_t at_ = 0;
@@ -48,9 +52,9 @@ class Reader {
     for (std::uint8_t v : expected) same = same && in_[at_++] == v;
     return same;
   }
-  std::uint16_t u16() { return static_cast<std::uint16_t>(unsigned_le(2)); }
-  std::uint32_t u32() { return static_cast<std::uint32_t>(unsigned_le(4)); }
-  double f64() { return std::bit_cast<double>(unsigned_le(8)); }
+  std::uint16_t u16() { return le::getU16(next(2)); }
+  std::uint32_t u32() { return le::getU32(next(4)); }
+  double f64() { return le::getF64(next(8)); }
   Eigen::Vector3d vec3() {
     Eigen::Vector3d v;
     for (int i = 0; i < 3; ++i) v[i] = f64();
@@ -59,10 +63,10 @@ class Reader {
   std::size_t offset() const { return at_; }
 
  private:
-  std::uint64_t unsigned_le(int n) {
-    std::uint64_t v = 0;
-    for (int i = 0; i < n; ++i) v |= static_cast<std::uint64_t>(in_[at_++]) << (8 * i);
-    return v;
+  const unsigned char* next(std::size_t n) {
+    const unsigned char* p = in_.data() + at_;
+    at_ += n;
+    return p;
   }
   std::span<const std::uint8_t> in_;
   std::size_t at_ = 0;
