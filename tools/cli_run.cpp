@@ -136,6 +136,7 @@ int runCommand(const RunArgs& args) {
   if (!sim.ok()) return fail(sim.error());
   if (Status st = setUpDebugging(args, **sim); !st.ok()) return fail(st.error());
   device.setWaitSeconds(args.device_wait_s);
+  device.setFiltersFile(args.device_filters);
   if (Status st = device.attach(args.device, args.gamepad_mapping, **sim); !st.ok()) return fail(st.error());
   std::unique_ptr<render::OffscreenRenderer> renderer;
   engine::RunOptions options;
@@ -207,6 +208,10 @@ void addRunOptions(CLI::App& cmd, RunArgs& run) {
                  "What drives the tool: scripted (the scene's tool_path, default), gamepad (the first game "
                  "controller), virtual-pad:FILE (a software pad playing a timed input script, e.g. "
                  "scenes/pad/default-course.yaml), udp:PORT (a device bridge on 127.0.0.1:PORT, e.g. hysim-udp-peer)");
+  cmd.add_option("--device-filters", run.device_filters,
+                 "udp: the bridge's motion scale, device-to-world transform and motion limit (YAML, see "
+                 "haptics/README.md)")
+      ->check(CLI::ExistingFile);
   cmd.add_option("--device-wait-s", run.device_wait_s, "udp: seconds to wait for the bridge's first packet")
       ->check(CLI::Range(0.0, 3600.0));
   cmd.add_option("--gamepad-mapping", run.gamepad_mapping, "Game controller mapping file (haptics/README.md)")

@@ -8,6 +8,7 @@
 #include "hysim/haptics/gamepad_mapping.hpp"
 #include "hysim/haptics/sdl_gamepad.hpp"
 #include "hysim/haptics/udp_device.hpp"
+#include "device_filters.hpp"
 
 namespace hysim::tools {
 
@@ -32,6 +33,12 @@ Status RunDevice::attachNetwork(const std::string& port_text, engine::Simulation
   if (port_text.empty() || *end != '\0' || port < 1 || port > 65535) {
     return Error{"--device udp:" + port_text + ": the port must be a number in 1..65535"};
   }
+  DeviceFilters filters;
+  if (!filters_file_.empty()) {
+    auto loaded = loadDeviceFilters(filters_file_);
+    if (!loaded.ok()) return Error{loaded.error()};
+    filters = loaded.value();
+  }
   haptics::NetworkDeviceOptions options;
   options.port = static_cast<std::uint16_t>(port);
   std::string error;
@@ -46,8 +53,8 @@ Status RunDevice::attachNetwork(const std::string& port_text, engine::Simulation
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(1));
   }
-  sim.setDevice(std::make_unique<haptics::FilteredDevice>(std::move(device), haptics::MotionScale{},
-                                                          haptics::PoseTransform{}, haptics::MotionLimit{}));
+  sim.setDevice(std::make_unique<haptics::FilteredDevice>(std::move(device), filters.scale, filters.transform,
+                                                          filters.limit));
   return Status::Ok();
 }
 

@@ -21,6 +21,8 @@ class RunDevice {
   // Sets the device up and attaches it to `sim` (before its first step). `mapping_file`: a
   // gamepad mapping (empty: the defaults). Errors name the spec or the file.
   Status attach(const std::string& spec, const std::string& mapping_file, engine::Simulation& sim);
+  // A filters file for udp:PORT (device_filters.hpp); empty: the default motion limit only.
+  void setFiltersFile(std::string path) { filters_file_ = std::move(path); }
   // How long udp:PORT waits for the bridge's first packet before it gives up.
   void setWaitSeconds(double seconds) { wait_s_ = seconds; }
   // Before each step: a virtual pad's script is played up to the time the step reads.
@@ -33,6 +35,7 @@ class RunDevice {
   std::unique_ptr<haptics::VirtualPad> pad_;
   std::optional<PadScript> script_;
   double wait_s_ = 10.0;
+  std::string filters_file_;
 };
 
 }  // namespace hysim::tools

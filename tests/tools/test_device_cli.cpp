@@ -64,6 +64,13 @@ TEST(DeviceCli, BadDeviceArgumentsAreClearErrors) {
   o = runHysim("run --steps 10 --device udp:99999");
   EXPECT_EQ(o.exit_code, 1);
   EXPECT_NE(o.text.find("1..65535"), std::string::npos) << o.text;
+  std::ofstream(dir + "/filters.yaml") << "scale: 0.5\nrotation_deg: [0, 0, 90]\nmax_sped_mm_s: 300\n";
+  o = runHysim("run --steps 10 --device udp:39872 --device-filters " + dir + "/filters.yaml");
+  EXPECT_EQ(o.exit_code, 1);
+  EXPECT_NE(o.text.find("filters.yaml:3: 'max_sped_mm_s': unknown key"), std::string::npos) << o.text;
+  std::ofstream(dir + "/filters.yaml") << "scale: 0\n";
+  o = runHysim("run --steps 10 --device udp:39872 --device-filters " + dir + "/filters.yaml");
+  EXPECT_NE(o.text.find("filters.yaml:1: 'scale': 0 is outside"), std::string::npos) << o.text;
   o = runHysim("run --steps 10 --device udp:39871 --device-wait-s 0.2");
   EXPECT_EQ(o.exit_code, 1);
   EXPECT_NE(o.text.find("no state packet"), std::string::npos) << o.text;
