@@ -68,6 +68,8 @@ void AppRecording::start(const engine::Scene& scene, engine::Simulation& sim, co
   }
   if (Status st = sim.recordInputTo(writer.get()); !st.ok()) {
     problem_ = st.error();
+    std::fprintf(stderr, "hysim-app: not recording: %s\n", problem_.c_str());
+    writer->discard();
     return;
   }
   writer_ = std::move(writer);

@@ -34,15 +34,23 @@ Status writeFileAtomically(const std::string& path, const std::string& text) {
   const fs::path parent = fs::path(path).parent_path();
   if (!parent.empty()) fs::create_directories(parent, dir_ec);
   if (dir_ec) return Error{"cannot create folder '" + parent.string() + "': " + dir_ec.message()};
+  bool written = false;
   {
     std::ofstream out(tmp, std::ios::binary);
-    if (!out) return Error{"cannot write '" + tmp + "'"};
     out << text;
-    if (!out.flush()) return Error{"cannot write '" + tmp + "'"};
+    written = static_cast<bool>(out.flush());
   }
   std::error_code ec;
+  if (!written) {
+    fs::remove(tmp, ec);
+    return Error{"cannot write '" + tmp + "'"};
+  }
   fs::rename(tmp, path, ec);
-  if (ec) return Error{"cannot move '" + tmp + "' to '" + path + "': " + ec.message()};
+  if (ec) {
+    std::error_code ignored;
+    fs::remove(tmp, ignored);
+    return Error{"cannot move '" + tmp + "' to '" + path + "': " + ec.message()};
+  }
   return Status::Ok();
 }
 
@@ -111,6 +119,9 @@ void printReport(const engine::RunReport& r, const std::string& frames, const st
                 static_cast<unsigned long long>(r.recording_states));
   }
   if (r.replay_scene_changed) std::printf("warning: the scene changed since the recording (--force)\n");
+  if (r.replay_version_changed) {
+    std::printf("warning: recorded by hysim %s, replayed by another build (--force)\n", r.recorded_version.c_str());
+  }
   if (!frames.empty()) std::printf("frames in %s\n", frames.c_str());
   if (!report.empty()) std::printf("report in %s\n", report.c_str());
 }
@@ -151,11 +162,17 @@ int runCommand(const RunArgs& args) {
     if (!header.ok()) return fail(header.error());
     std::string error;
     if (!recorder.open(args.record, *header, error)) return fail(error);
-    if (Status st = (*sim)->recordInputTo(&recorder); !st.ok()) return fail(st.error());
+    if (Status st = (*sim)->recordInputTo(&recorder); !st.ok()) {
+      recorder.discard();
+      return fail(st.error());
+    }
   }
   if (!args.quiet) printModel(*scene, **sim);
   auto report = engine::run(**sim, options);
-  if (!report.ok()) return fail(report.error());
+  if (!report.ok()) {
+    recorder.discard();
+    return fail(report.error());
+  }
   if (recorder.isOpen()) {
     std::string error;
     if (!recorder.finish(error)) return fail(error);
@@ -186,6 +203,8 @@ int replayCommand(const ReplayArgs& args) {
   report->recorded_scene_hash = recording->header.scene_hash;
   report->scene_hash_now = scene->hash_now;
   report->replay_scene_changed = scene->changed;
+  report->recorded_version = recording->header.hysim_version;
+  report->replay_version_changed = scene->version_changed;
   return finishRun(*report, args.frames, args.report, args.quiet);
 }
 
@@ -241,7 +260,8 @@ void addReplayOptions(CLI::App& cmd, ReplayArgs& replay) {
       ->check(CLI::PositiveNumber);
   cmd.add_option("--report", replay.report, "Write the JSON report to this file");
   cmd.add_flag("--force", replay.force,
-               "Replay even though the scene's content changed since the recording (the report says so)");
+               "Replay even though the scene's content or the hysim build changed since the recording (the report says "
+               "so)");
   cmd.add_flag("--quiet", replay.quiet, "Print nothing but errors");
 }
 

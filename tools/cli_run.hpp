@@ -24,8 +24,8 @@ struct RunArgs {
   std::string record;     // write the consumed device states to this file
   std::string device;     // see run_device.hpp; empty: the scene's script
   std::string gamepad_mapping;
-  double device_wait_s = 10.0;
-  std::string device_filters;  // udp: scale, transform and motion limit (YAML)  // udp: how long to wait for the bridge's first packet
+  std::string device_filters;   // udp: scale, transform and motion limit (YAML)
+  double device_wait_s = 10.0;  // udp: how long to wait for the bridge's first packet
 };
 
 struct ReplayArgs {

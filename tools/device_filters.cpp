@@ -80,6 +80,8 @@ Result<DeviceFilters> loadDeviceFilters(const std::string& path) {
   YAML::Node root;
   try {
     root = YAML::LoadFile(path);
+  } catch (const YAML::BadFile&) {
+    return Error{path + ": cannot open"};
   } catch (const YAML::Exception& e) {
     return Error{path + ":" + std::to_string(e.mark.line + 1) + ": " + e.msg};
   }
@@ -87,7 +89,8 @@ Result<DeviceFilters> loadDeviceFilters(const std::string& path) {
   DeviceFilters out;
   Limits limits;
   for (const auto& kv : root) {
-    if (Status st = readKey(path, kv.first.as<std::string>(), kv.second, out, limits); !st.ok()) {
+    if (!kv.first.IsScalar()) return Error{at(path, kv.first, "?") + ": a key must be a name"};
+    if (Status st = readKey(path, kv.first.Scalar(), kv.second, out, limits); !st.ok()) {
       return Error{st.error()};
     }
   }

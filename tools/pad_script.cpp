@@ -61,7 +61,8 @@ Result<PadEvent> readEvent(const std::string& path, const YAML::Node& n, double 
     return Error{where(path, n["t_s"]) + ": 't_s': " + n["t_s"].Scalar() + " (events go forward in time from 0)"};
   }
   for (const auto& kv : n) {
-    const std::string key = kv.first.as<std::string>();
+    if (!kv.first.IsScalar()) return Error{where(path, kv.first) + ": a key must be an input name"};
+    const std::string key = kv.first.Scalar();
     if (key == "t_s") continue;
     auto input = readInput(path, key, kv.second);
     if (!input.ok()) return Error{input.error()};
@@ -76,6 +77,8 @@ Result<PadScript> PadScript::load(const std::string& path) {
   YAML::Node root;
   try {
     root = YAML::LoadFile(path);
+  } catch (const YAML::BadFile&) {
+    return Error{path + ": cannot open"};
   } catch (const YAML::Exception& e) {
     return Error{path + ":" + std::to_string(e.mark.line + 1) + ": " + e.msg};
   }

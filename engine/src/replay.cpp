@@ -4,13 +4,11 @@
 #include <filesystem>
 #include <fstream>
 
+#include "hysim/haptics/little_endian.hpp"
 #include "hysim/haptics/replay_device.hpp"
 
 namespace hysim::engine {
 namespace {
-
-constexpr std::uint64_t kFnvOffset = 14695981039346656037ull;
-constexpr std::uint64_t kFnvPrime = 1099511628211ull;
 
 // Folds the bytes of the file at `path` into the FNV-1a hash `h`.
 Status hashFile(const std::string& path, std::uint64_t& h) {
@@ -21,11 +19,11 @@ Status hashFile(const std::string& path, std::uint64_t& h) {
   char buffer[1 << 16];
   while (in) {
     in.read(buffer, sizeof(buffer));
-    const std::streamsize n = in.gcount();
-    for (std::streamsize i = 0; i < n; ++i) h = (h ^ static_cast<unsigned char>(buffer[i])) * kFnvPrime;
+    h = haptics::le::fnv1a64(h, reinterpret_cast<const unsigned char*>(buffer), static_cast<std::size_t>(in.gcount()));
   }
   if (in.bad()) return Error{path + ": read error"};
-  h = (h ^ 0xffu) * kFnvPrime;  // a separator: moving bytes between files changes the hash
+  const unsigned char separator = 0xff;  // moving bytes between files changes the hash
+  h = haptics::le::fnv1a64(h, &separator, 1);
   return Status::Ok();
 }
 
@@ -53,7 +51,7 @@ int stepsRecorded(const haptics::Recording& recording) {
 std::string hysimVersion() { return HYSIM_VERSION_STRING; }
 
 Result<std::uint64_t> sceneContentHash(const Scene& scene) {
-  std::uint64_t h = kFnvOffset;
+  std::uint64_t h = haptics::le::kFnv64Offset;
   for (const std::string* path : {&scene.path, &scene.mesh_path, &scene.tool_mesh_path}) {
     if (path->empty()) continue;
     if (Status st = hashFile(*path, h); !st.ok()) return Error{st.error()};
@@ -111,6 +109,12 @@ Result<ReplayScene> loadReplayScene(const haptics::Recording& recording, bool fo
     return Error{h.scene_path + " changed since the recording: content hash " + hexOf(out.hash_now) +
                  " now, " + hexOf(h.scene_hash) + " recorded (the scene file or a mesh it loads); --force replays "
                  "it anyway and flags the report"};
+  }
+  // Another build may step differently: the states are the same only with the same code.
+  out.version_changed = h.hysim_version != hysimVersion();
+  if (out.version_changed && !force) {
+    return Error{"recorded with hysim " + h.hysim_version + ", this is hysim " + hysimVersion() +
+                 ": another build may give other states; --force replays it anyway and flags the report"};
   }
   return out;
 }

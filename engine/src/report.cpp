@@ -166,6 +166,8 @@ std::string reportJson(const RunReport& r) {
       j["recording"]["scene_hash_recorded"] = hashHex(r.recorded_scene_hash);
       j["recording"]["scene_hash_now"] = hashHex(r.scene_hash_now);
       j["recording"]["scene_changed"] = r.replay_scene_changed;
+      j["recording"]["recorded_by"] = r.recorded_version;
+      j["recording"]["version_changed"] = r.replay_version_changed;
     }
   }
   j["per_pass"] = per_pass;

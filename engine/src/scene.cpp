@@ -1,5 +1,7 @@
 #include "hysim/engine/scene.hpp"
 
+#include "hysim/haptics/device.hpp"
+
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
@@ -219,7 +221,12 @@ haptics::Keyframe parseKeyframe(const Reader& r, const YAML::Node& n, const hapt
   k.axis = r.unitVec3(r.require(n, "axis", "tool_path[]"), "axis");
   if (n["up"]) k.up = r.unitVec3(n["up"], "up");
   if (std::abs(k.up.dot(k.axis)) > 0.999) r.fail(n["up"] ? n["up"] : n, "'up' must not be parallel to 'axis'");
-  if (n["extension_mm"]) k.extension_mm = r.number(n["extension_mm"], "extension_mm");
+  if (n["extension_mm"]) {
+    k.extension_mm = r.number(n["extension_mm"], "extension_mm");
+    if (k.extension_mm < 0.0 || k.extension_mm > haptics::kMaxLoopExtensionMm) {
+      r.fail(n["extension_mm"], "'extension_mm' must be in [0, 100], got " + n["extension_mm"].Scalar());
+    }
+  }
   if (n["pedal"]) k.pedal = r.boolean(n["pedal"], "pedal");
   if (n["move"]) {
     const std::string move = r.string(n["move"], "move");

@@ -205,6 +205,11 @@ void Simulation::setDevice(std::unique_ptr<haptics::Device> device) {
   if (recorder_ != nullptr) recorder_->append(device_state_, true);
   pose_ = device_state_.pose;
   coupling_.reset(pose_.tip, device_state_.velocity_mm_s);
+  // The loop starts where the new device holds it: no sweep from the old tool's place.
+  if (wire_.rows() > 0) {
+    loopPoints(loop_, pose_, wire_);
+    previous_wire_ = wire_;
+  }
   // The last step's reaction was at the old tool; the new one starts free of it.
   tool_force_n_.setZero();
   tool_stiffness_.setZero();

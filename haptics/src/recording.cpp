@@ -7,6 +7,8 @@
 #include <filesystem>
 #include <fstream>
 
+#include <unistd.h>
+
 #include "hysim/haptics/little_endian.hpp"
 
 namespace hysim::haptics {
@@ -15,18 +17,11 @@ namespace {
 constexpr char kMagic[9] = "HYSIMREC";
 constexpr char kEndMagic[9] = "HYSIMEND";
 constexpr int kFixedHeaderBytes = 32;
-constexpr std::uint64_t kFnv64Offset = 14695981039346656037ull;
-constexpr std::uint64_t kFnv64Prime = 1099511628211ull;
-constexpr double kMaxExtensionMm = 100.0;
+using le::kFnv64Offset;
 
 // Record layout (offsets in bytes).
 constexpr int kTime = 0, kTip = 8, kRotation = 32, kExtension = 104, kVelocity = 112, kAngular = 136,
               kExtensionVelocity = 160, kButtons = 168, kPedal = 172, kFlags = 173, kReserved = 174, kCheck = 176;
-
-std::uint64_t fnv64(std::uint64_t h, const unsigned char* p, std::size_t n) {
-  for (std::size_t i = 0; i < n; ++i) h = (h ^ p[i]) * kFnv64Prime;
-  return h;
-}
 
 void putVector(unsigned char* p, const Eigen::Vector3d& v) {
   for (int i = 0; i < 3; ++i) le::putF64(p + 8 * i, v[i]);
@@ -49,7 +44,7 @@ bool plausible(const DeviceState& s, std::string& reason) {
     reason = "the orientation is not a rotation";
     return false;
   }
-  if (p.extension_mm < 0.0 || p.extension_mm > kMaxExtensionMm) {
+  if (p.extension_mm < 0.0 || p.extension_mm > kMaxLoopExtensionMm) {
     reason = "loop extension " + std::to_string(p.extension_mm) + " mm is outside [0, 100]";
     return false;
   }
@@ -149,7 +144,7 @@ bool readRecords(Reader& r, Recording& out) {
     if (i > 0 && out.states[i].state.time_s < out.states[i - 1].state.time_s) {
       return r.fail(r.at, "record " + std::to_string(i) + ": time goes backwards");
     }
-    checksum = fnv64(checksum, p, kRecordBytes);
+    checksum = le::fnv1a64(checksum, p, kRecordBytes);
   }
   if (const std::uint64_t n = le::getU64(r.bytes.data() + end_at + 8); n != count) {
     return r.fail(end_at + 8, "the end marker counts " + std::to_string(n) + " records, the file holds " +
@@ -230,6 +225,10 @@ RecordingWriter::~RecordingWriter() {
 }
 
 bool RecordingWriter::open(const std::string& path, const RecordingHeader& header, std::string& error) {
+  if (file_ != nullptr) {
+    error = "recording '" + path_ + "' is still open";
+    return false;
+  }
   for (const std::string* s : {&header.scene_path, &header.mesh_path, &header.chips_mode, &header.hysim_version,
                                &header.device_name}) {
     if (s->size() > static_cast<std::size_t>(kMaxRecordingString)) {
@@ -250,14 +249,18 @@ bool RecordingWriter::open(const std::string& path, const RecordingHeader& heade
   write_failed_ = std::fwrite(bytes.data(), 1, bytes.size(), file_) != bytes.size();
   records_ = 0;
   checksum_ = kFnv64Offset;
+  first_bad_.clear();
   return true;
 }
 
 void RecordingWriter::append(const DeviceState& state, bool attached) {
   if (file_ == nullptr) return;
+  if (first_bad_.empty() && !plausible(state, first_bad_)) {
+    first_bad_ = "record " + std::to_string(records_) + ": " + first_bad_;
+  }
   std::array<unsigned char, kRecordBytes> bytes;
   encodeRecord(state, attached, bytes.data());
-  checksum_ = fnv64(checksum_, bytes.data(), bytes.size());
+  checksum_ = le::fnv1a64(checksum_, bytes.data(), bytes.size());
   if (std::fwrite(bytes.data(), 1, bytes.size(), file_) != bytes.size()) write_failed_ = true;
   ++records_;
 }
@@ -272,11 +275,16 @@ bool RecordingWriter::finish(std::string& error) {
   le::putU64(end.data() + 8, records_);
   le::putU64(end.data() + 16, checksum_);
   if (std::fwrite(end.data(), 1, end.size(), file_) != end.size()) write_failed_ = true;
+  const bool synced = std::fflush(file_) == 0 && fsync(fileno(file_)) == 0;  // on disk before the rename
   const bool closed = std::fclose(file_) == 0;
   file_ = nullptr;
   const std::string tmp = path_ + ".tmp";
-  if (write_failed_ || !closed) {
+  if (write_failed_ || !synced || !closed) {
     error = "cannot write '" + tmp + "' (disk full?)";
+    return false;
+  }
+  if (!first_bad_.empty()) {  // kept as .tmp: a replay could not take it
+    error = tmp + ": " + first_bad_ + " (the device delivered a state no replay can take)";
     return false;
   }
   std::error_code ec;
@@ -286,6 +294,14 @@ bool RecordingWriter::finish(std::string& error) {
     return false;
   }
   return true;
+}
+
+void RecordingWriter::discard() {
+  if (file_ == nullptr) return;
+  std::fclose(file_);
+  file_ = nullptr;
+  std::error_code ec;
+  std::filesystem::remove(path_ + ".tmp", ec);
 }
 
 bool readRecording(const std::string& path, Recording& out, std::string& error) {

@@ -125,6 +125,29 @@ TEST(Replay, AChangedSceneIsRefusedUnlessForced) {
   EXPECT_TRUE(forced->changed);
 }
 
+TEST(Replay, AnotherBuildsRecordingIsRefusedUnlessForced) {
+  const fs::path dir = testing::testDir("replay");
+  auto scene = loadScene(testing::writeSlabScene(dir, false));
+  ASSERT_TRUE(scene.ok()) << scene.error();
+  auto sim = makeSim(*scene);
+  haptics::RecordingWriter w;
+  startRecording(*sim, *scene, (dir / "old.hyrec").string(), w);
+  sim->step();
+  std::string error;
+  ASSERT_TRUE(w.finish(error)) << error;
+  auto rec = readBack((dir / "old.hyrec").string());
+  EXPECT_EQ(rec->header.hysim_version, hysimVersion());
+  rec->header.hysim_version = "0.0 (an old commit)";
+  auto refused = loadReplayScene(*rec, false);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_NE(refused.error().find("0.0 (an old commit)"), std::string::npos) << refused.error();
+  EXPECT_NE(refused.error().find(hysimVersion()), std::string::npos) << refused.error();
+  auto forced = loadReplayScene(*rec, true);
+  ASSERT_TRUE(forced.ok()) << forced.error();
+  EXPECT_TRUE(forced->version_changed);
+  EXPECT_FALSE(forced->changed);
+}
+
 TEST(Replay, TheMeshIsPartOfTheScenesContent) {
   const fs::path dir = testing::testDir("replay");
   auto scene = loadScene(testing::writeSlabScene(dir, false));

@@ -115,6 +115,12 @@ TEST(SceneErrors, NegativeValue) {
               ":4:", "'young_modulus_kpa' must be positive");
 }
 
+TEST(SceneErrors, LoopExtensionOutOfRange) {
+  expectError("extension.yaml",
+              replaceLine(minimalScene(), 10, "  - {t_s: 0, tip: [0, 0, 0], axis: [0, 0, 1], extension_mm: 120}"), ":10:",
+              "'extension_mm' must be in [0, 100]");
+}
+
 TEST(SceneErrors, MissingRequiredKey) {
   expectError("missing_key.yaml", replaceLine(minimalScene(), 1, "# no name"), ":", "missing required key 'name'");
 }

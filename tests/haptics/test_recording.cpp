@@ -137,6 +137,34 @@ TEST(Recording, AnOlderFileIsReplacedOnlyWhenTheNewOneIsFinished) {
   EXPECT_NE(error.find("truncated"), std::string::npos) << error;
 }
 
+TEST(Recording, AStateNoReplayCouldTakeFailsTheRecordingNamingIt) {
+  const fs::path dir = testing::testDir("Recording");
+  const std::string path = (dir / "bad.hyrec").string();
+  RecordingWriter w;
+  std::string error;
+  ASSERT_TRUE(w.open(path, sampleHeader(), error)) << error;
+  EXPECT_FALSE(w.open(path, sampleHeader(), error));  // still open
+  auto states = sampleStates(5, 3);
+  states[3].velocity_mm_s.x() = std::numeric_limits<double>::infinity();
+  for (const DeviceState& s : states) w.append(s, false);
+  EXPECT_FALSE(w.finish(error));
+  EXPECT_NE(error.find("record 3: a number is not finite"), std::string::npos) << error;
+  EXPECT_FALSE(fs::exists(path));
+  EXPECT_TRUE(fs::exists(path + ".tmp"));  // kept for a look, never taken as a session
+}
+
+TEST(Recording, DiscardRemovesTheTemporaryFile) {
+  const fs::path dir = testing::testDir("Recording");
+  const std::string path = (dir / "gone.hyrec").string();
+  RecordingWriter w;
+  std::string error;
+  ASSERT_TRUE(w.open(path, sampleHeader(), error)) << error;
+  w.append(sampleStates(1, 1)[0], true);
+  w.discard();
+  EXPECT_FALSE(fs::exists(path + ".tmp"));
+  EXPECT_FALSE(fs::exists(path));
+}
+
 TEST(Recording, AnUnwritableFolderIsAClearError) {
   RecordingWriter w;
   std::string error;

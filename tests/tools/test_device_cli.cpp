@@ -3,6 +3,8 @@
 // replayed to the same state_hash.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <cstdlib>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -80,7 +82,8 @@ TEST(DeviceCli, BadDeviceArgumentsAreClearErrors) {
 // wall clock on it. What arrives is counted; the recording replays without the network.
 TEST(DeviceCli, TheUdpPeerDrivesARunOverLoopback) {
   const std::string dir = hysim::testing::freshOutputDir("device_cli", "udp");
-  const std::string port = "39873";
+  // A port of this process's own: two test runs side by side do not meet.
+  const std::string port = std::to_string(20000 + ::getpid() % 20000);
   const std::string peer = std::string(HYSIM_UDP_PEER) + " --port " + port + " --seconds 4 > " + dir +
                            "/peer.log 2>&1 &";
   const Output o = runHysim("run --device udp:" + port + " --realtime --steps 1500 --quiet --record " + dir +

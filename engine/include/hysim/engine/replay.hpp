@@ -35,10 +35,12 @@ struct ReplayScene {
   Scene scene;                 // with the recorded overrides
   std::uint64_t hash_now = 0;  // of its content now
   bool changed = false;        // hash_now differs from the recording's (accepted only with force)
+  bool version_changed = false;  // another hysim version or commit recorded it (only with force)
 };
 // Loads the scene a recording names, with the run's overrides. A scene whose content changed
-// since the recording is refused with both hashes in the message, unless `force`; a
-// different step dt always is.
+// since the recording is refused with both hashes in the message, and a recording made by
+// another hysim version or commit with both versions, unless `force`; a different step dt
+// always is.
 Result<ReplayScene> loadReplayScene(const haptics::Recording& recording, bool force);
 
 // Steps `simulation` (made from loadReplayScene's scene) on the recorded device states, one

@@ -75,6 +75,8 @@ struct RunReport {
   bool replay = false;
   std::uint64_t recorded_scene_hash = 0, scene_hash_now = 0;
   bool replay_scene_changed = false;
+  std::string recorded_version;  // replay: the hysim that recorded it
+  bool replay_version_changed = false;
   std::vector<PassRecord> passes;  // shaving passes (cuts), in order
   double initial_myoma_mm3 = 0.0;
   double electrode_active_s = 0.0;

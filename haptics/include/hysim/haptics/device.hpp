@@ -10,6 +10,10 @@
 
 namespace hysim::haptics {
 
+// The loop electrode's extension beyond its rest position never exceeds this (mm): scenes,
+// recordings and devices keep to it.
+inline constexpr double kMaxLoopExtensionMm = 100.0;
+
 struct DeviceInfo {
   std::string name;
   Eigen::Vector3d workspace_min_mm{-100, -100, -100};  // reachable tip positions (world frame)

@@ -35,6 +35,13 @@ inline std::uint64_t getU64(const unsigned char* p) {
 }
 inline double getF64(const unsigned char* p) { return std::bit_cast<double>(getU64(p)); }
 
+// FNV-1a, 64 bits, continuing from `h` (start with kFnv64Offset): content hashes and checksums.
+inline constexpr std::uint64_t kFnv64Offset = 14695981039346656037ull;
+inline std::uint64_t fnv1a64(std::uint64_t h, const unsigned char* p, std::size_t n) {
+  for (std::size_t i = 0; i < n; ++i) h = (h ^ p[i]) * 1099511628211ull;
+  return h;
+}
+
 // FNV-1a, 32 bits: a cheap check that a record was not damaged (not a cryptographic hash).
 inline std::uint32_t fnv1a32(const unsigned char* p, std::size_t n) {
   std::uint32_t h = 2166136261u;

@@ -55,8 +55,12 @@ class RecordingWriter {
   bool open(const std::string& path, const RecordingHeader& header, std::string& error);
   bool isOpen() const { return file_ != nullptr; }
   void append(const DeviceState& state, bool attached);
-  // Writes the end marker, flushes, renames PATH.tmp to PATH.
+  // Writes the end marker, flushes to disk, renames PATH.tmp to PATH. A state that no replay
+  // could take (not finite, not a rotation; a device's fault) fails it, naming the record,
+  // and leaves PATH.tmp.
   bool finish(std::string& error);
+  // Closes and removes PATH.tmp (a run that failed before it began).
+  void discard();
   std::uint64_t records() const { return records_; }
   const std::string& path() const { return path_; }
 
@@ -66,6 +70,7 @@ class RecordingWriter {
   std::uint64_t records_ = 0;
   std::uint64_t checksum_ = 0;  // FNV-1a 64 over every record's bytes
   bool write_failed_ = false;
+  std::string first_bad_;  // the first implausible record and why
   std::vector<char> stdio_buffer_;
 };
 

@@ -170,7 +170,11 @@ void MappingReader::checkKeys(const YAML::Node& map, const std::string& where,
     return;
   }
   for (const auto& kv : map) {
-    const std::string k = kv.first.as<std::string>();
+    if (!kv.first.IsScalar()) {
+      fail(kv.first, "'" + where + "': a key must be a name");
+      return;
+    }
+    const std::string k = kv.first.Scalar();
     if (std::find(keys.begin(), keys.end(), k) != keys.end()) continue;
     std::string expected;
     for (std::string_view e : keys) expected += (expected.empty() ? "" : ", ") + std::string(e);

@@ -256,7 +256,8 @@ void SdlGamepadDevice::updateConstantForce(const Eigen::Vector3d& force_n) {
   const double push_x = f.x(), push_y = -f.z();
   const auto level = static_cast<Sint16>(
       std::lround(32767.0 * std::clamp(std::hypot(push_x, push_y) / info_.max_force_n, 0.0, 1.0)));
-  if (effect_id_ >= 0 && std::abs(level - sent_level_) < 256 && level != 0) return;  // not worth a USB packet
+  // Small changes are not worth a USB packet; reaching zero always is, once.
+  if (effect_id_ >= 0 && (level == sent_level_ || (level != 0 && std::abs(level - sent_level_) < 256))) return;
   SDL_HapticEffect e;
   std::memset(&e, 0, sizeof(e));
   e.type = SDL_HAPTIC_CONSTANT;
