@@ -1,6 +1,6 @@
 #include "device_filters.hpp"
 
-#include <yaml-cpp/yaml.h>
+#include "yaml_file.hpp"
 
 #include <Eigen/Geometry>
 #include <cmath>
@@ -77,14 +77,9 @@ Status readKey(const std::string& path, const std::string& key, const YAML::Node
 }  // namespace
 
 Result<DeviceFilters> loadDeviceFilters(const std::string& path) {
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(path);
-  } catch (const YAML::BadFile&) {
-    return Error{path + ": cannot open"};
-  } catch (const YAML::Exception& e) {
-    return Error{path + ":" + std::to_string(e.mark.line + 1) + ": " + e.msg};
-  }
+  auto loaded = loadYamlFile(path);
+  if (!loaded.ok()) return Error{loaded.error()};
+  const YAML::Node& root = *loaded;
   if (!root.IsMap()) return Error{path + ": expected a map of keys"};
   DeviceFilters out;
   Limits limits;

@@ -1,6 +1,6 @@
 #include "pad_script.hpp"
 
-#include <yaml-cpp/yaml.h>
+#include "yaml_file.hpp"
 
 #include <cmath>
 
@@ -74,14 +74,9 @@ Result<PadEvent> readEvent(const std::string& path, const YAML::Node& n, double 
 }  // namespace
 
 Result<PadScript> PadScript::load(const std::string& path) {
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(path);
-  } catch (const YAML::BadFile&) {
-    return Error{path + ": cannot open"};
-  } catch (const YAML::Exception& e) {
-    return Error{path + ":" + std::to_string(e.mark.line + 1) + ": " + e.msg};
-  }
+  auto loaded = loadYamlFile(path);
+  if (!loaded.ok()) return Error{loaded.error()};
+  const YAML::Node& root = *loaded;
   if (!root.IsSequence() || root.size() == 0) return Error{path + ": expected a list of events"};
   PadScript script;
   double t = 0.0;
