@@ -208,12 +208,18 @@ int replayCommand(const ReplayArgs& args) {
   return finishRun(*report, args.frames, args.report, args.quiet);
 }
 
+// What run and replay write, and how much they say.
+void addOutputOptions(CLI::App& cmd, std::string& frames, int& every, std::string& report, bool& quiet) {
+  cmd.add_option("--frames", frames, "Write PNG frames into this folder");
+  cmd.add_option("--every", every, "Render a frame every K steps (default: the scene's)")->check(CLI::PositiveNumber);
+  cmd.add_option("--report", report, "Write the JSON report to this file");
+  cmd.add_flag("--quiet", quiet, "Print nothing but errors");
+}
+
 void addRunOptions(CLI::App& cmd, RunArgs& run) {
   cmd.add_option("scene", run.scene, "Scene file (default: scenes/default.yaml)")->check(CLI::ExistingFile);
   cmd.add_option("--steps", run.steps, "Number of steps (default: the scene's)")->check(CLI::NonNegativeNumber);
-  cmd.add_option("--frames", run.frames, "Write PNG frames into this folder");
-  cmd.add_option("--every", run.every, "Render a frame every K steps (default: the scene's)")->check(CLI::PositiveNumber);
-  cmd.add_option("--report", run.report, "Write the JSON report to this file");
+  addOutputOptions(cmd, run.frames, run.every, run.report, run.quiet);
   cmd.add_option("--chips", run.chips, "Override the scene's chips mode: remove or simulate")
       ->check(CLI::IsMember({"remove", "simulate"}));
   cmd.add_option("--mesh", run.mesh,
@@ -235,7 +241,6 @@ void addRunOptions(CLI::App& cmd, RunArgs& run) {
       ->check(CLI::Range(0.0, 3600.0));
   cmd.add_option("--gamepad-mapping", run.gamepad_mapping, "Game controller mapping file (haptics/README.md)")
       ->check(CLI::ExistingFile);
-  cmd.add_flag("--quiet", run.quiet, "Print nothing but errors");
   cmd.add_flag("--realtime", run.realtime,
                "Pace the steps to the wall clock, with the haptic thread (1 kHz) rendering forces on a simulated "
                "device; the state sequence is the same as without");
@@ -255,14 +260,10 @@ void addRunOptions(CLI::App& cmd, RunArgs& run) {
 void addReplayOptions(CLI::App& cmd, ReplayArgs& replay) {
   cmd.add_option("recording", replay.recording, "Recording file (hysim run --record, or the trainee app's)")
       ->required();
-  cmd.add_option("--frames", replay.frames, "Write PNG frames into this folder");
-  cmd.add_option("--every", replay.every, "Render a frame every K steps (default: the scene's)")
-      ->check(CLI::PositiveNumber);
-  cmd.add_option("--report", replay.report, "Write the JSON report to this file");
+  addOutputOptions(cmd, replay.frames, replay.every, replay.report, replay.quiet);
   cmd.add_flag("--force", replay.force,
                "Replay even though the scene's content or the hysim build changed since the recording (the report says "
                "so)");
-  cmd.add_flag("--quiet", replay.quiet, "Print nothing but errors");
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 // `hysim cut` (2D) and `hysim tables --table 1`, run as a user would.
 #include <gtest/gtest.h>
 
+#include "read_json.hpp"
 #include "run_hysim.hpp"
 
 #include <array>
@@ -20,10 +21,7 @@ Output hysim(const std::string& args) { return hysim::testing::runHysim(args); }
 
 std::string outDir(const std::string& name) { return hysim::testing::freshOutputDir("cli_cut2d", name); }
 
-nlohmann::json readJson(const std::string& path) {
-  std::ifstream in(path);
-  return nlohmann::json::parse(in, nullptr, false);
-}
+using hysim::testing::readJson;
 
 const std::string kMesh1 = "tests/data/cutting/table1_mesh1.msh";
 const std::string kLine1a = "--line=-5,27,105,41";  // the Table-1 cut 1a

@@ -2,6 +2,7 @@
 // a user would: outputs read back and validated, stats JSON, one-line errors on bad input.
 #include <gtest/gtest.h>
 
+#include "read_json.hpp"
 #include "run_hysim.hpp"
 
 #include <cmath>
@@ -28,10 +29,7 @@ Output hysim(const std::string& args) { return hysim::testing::runHysim(args); }
 
 std::string outDir(const std::string& name) { return hysim::testing::freshOutputDir("cli_cut3d", name); }
 
-nlohmann::json readJson(const std::string& path) {
-  std::ifstream in(path);
-  return nlohmann::json::parse(in, nullptr, false);
-}
+using hysim::testing::readJson;
 
 std::string readText(const std::string& path) {
   std::ifstream in(path, std::ios::binary);

@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "read_json.hpp"
 #include "run_hysim.hpp"
 
 namespace {
@@ -17,10 +18,7 @@ namespace {
 using hysim::testing::Output;
 using hysim::testing::runHysim;
 
-nlohmann::json readJson(const std::string& path) {
-  std::ifstream in(path);
-  return nlohmann::json::parse(in);
-}
+using hysim::testing::readJson;
 
 // The default course's first pass (the pad script of scenes/pad/default-course.yaml).
 std::string writePadScript(const std::string& dir) {

@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "read_json.hpp"
 #include "run_hysim.hpp"
 #include "slab_scenes.hpp"
 
@@ -16,10 +17,7 @@ namespace {
 using hysim::testing::Output;
 using hysim::testing::runHysim;
 
-nlohmann::json readJson(const std::string& path) {
-  std::ifstream in(path);
-  return nlohmann::json::parse(in);
-}
+using hysim::testing::readJson;
 
 TEST(ReplayCli, ARecordedRunReplaysToTheSameHash) {
   const std::string dir = hysim::testing::freshOutputDir("replay_cli", "same_hash");
