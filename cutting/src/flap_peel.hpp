@@ -27,22 +27,6 @@ struct StarShape {
 };
 StarShape starShape(const TetMesh& mesh, int v, const std::vector<std::int32_t>& around);
 
-// The optimiser's node -> tet lists (live tets with the node, in index order): a CSR row, or
-// a row of the pool where the node's list was rebuilt after collapses.
-struct NodeStars {
-  const std::vector<std::int32_t>& off;
-  const StarVector& star;
-  const std::vector<std::int32_t>& pool_start;  // -1: the CSR row
-  const std::vector<std::int32_t>& pool_len;
-  const std::vector<std::int32_t>& pool;
-  const std::int32_t* begin(int n) const {
-    return pool_start[n] >= 0 ? pool.data() + pool_start[n] : star.data() + off[n];
-  }
-  const std::int32_t* end(int n) const {
-    return pool_start[n] >= 0 ? pool.data() + pool_start[n] + pool_len[n] : star.data() + off[n + 1];
-  }
-};
-
 // `stars` must list the live tets (those not *dead) when called; removed tets are only
 // marked in *dead.
 // `quality(t)` (optional) returns radiusRatio of tet t's four positions in its node order

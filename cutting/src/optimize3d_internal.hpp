@@ -12,6 +12,7 @@
 
 #include "hysim/cutting/cut3d.hpp"
 #include "hysim/cutting/no_init_allocator.hpp"
+#include "hysim/cutting/tet_mesh_editor.hpp"
 
 namespace hysim::cutting {
 
@@ -44,17 +45,6 @@ struct IndexBits {
   std::vector<std::int32_t> words;
 };
 
-using StarVector = std::vector<std::int32_t, NoInitAllocator<std::int32_t>>;
-
-// Node -> tet lists of a tet mesh (each list ascending): CSR rows (off, star), or, where
-// pool_start[n] >= 0, pool_len[n] entries of `pool` from there.
-struct StarLists {
-  std::vector<std::int32_t> off;
-  StarVector star;  // (not zeroed as it grows: buildStarLists writes every entry)
-  std::vector<std::int32_t> pool_start, pool_len, pool;
-};
-// The CSR rows of all numNodes nodes of T (pool empty).
-void buildStarLists(const Tets& T, int numNodes, StarLists* lists);
 // `lists` holds the lists of `before`; `after` is the same mesh with the rows `changed` (below
 // before.rows(), may repeat) rewritten and rows appended, with numNodesAfter nodes (nodes
 // appended too). Afterwards `lists` holds the lists of `after`: the rows of the nodes of the
