@@ -410,6 +410,7 @@ void runCutJob(const Tissue& base, const Scene& scene, const CutJobInput& in, Cu
   rec.unoptimised_chip_elements = cut->report.cut_off_elements;
   rec.cut_faces = cut->report.cut_faces;
   rec.volume_drift_mm3 = cut->report.volume_drift;
+  rec.peeled_mm3 = cut->report.peeled_volume;
   for (const cutting::MaterialVolume& m : cut->report.material_volumes)
     if (m.label == myomaLabel(scene)) rec.volume_drift_myoma_mm3 = m.drift();
 

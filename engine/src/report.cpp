@@ -30,6 +30,7 @@ RunSummary summarize(const RunReport& r) {
     removed += p.removed_mm3;
     s.volume_drift_mm3 += p.volume_drift_mm3;
     s.volume_drift_myoma_mm3 += p.volume_drift_myoma_mm3;
+    s.peeled_mm3 += p.peeled_mm3;
     cut_ms.push_back(p.cut_ms);
   }
   s.myoma_resected_pct = r.initial_myoma_mm3 > 0.0 ? 100.0 * s.myoma_resected_mm3 / r.initial_myoma_mm3 : 0.0;
@@ -122,6 +123,7 @@ std::string reportJson(const RunReport& r) {
     e["removed_myoma_mm3"] = p.removed_myoma_mm3;
     e["volume_drift_mm3"] = p.volume_drift_mm3;
     e["volume_drift_myoma_mm3"] = p.volume_drift_myoma_mm3;
+    e["peeled_mm3"] = p.peeled_mm3;
     e["sweep_area_mm2"] = p.sweep_area_mm2;
     e["crossed_edges"] = p.crossed_edges;
     e["snapped_nodes"] = p.snapped_nodes;
@@ -144,6 +146,7 @@ std::string reportJson(const RunReport& r) {
   j["volume_drift_mm3"] = sum.volume_drift_mm3;
   j["volume_drift_myoma_mm3"] = sum.volume_drift_myoma_mm3;
   j["volume_drift_healthy_mm3"] = sum.volume_drift_healthy_mm3;
+  j["peeled_mm3"] = sum.peeled_mm3;
   j["electrode_active_s"] = r.electrode_active_s;
   j["path_length_mm"] = r.path_length_mm;
   j["passes"] = r.passes.size();

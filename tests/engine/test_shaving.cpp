@@ -86,15 +86,18 @@ TEST(Shaving, PassReportsTheVolumeItsCutLost) {
   ASSERT_GT(myoma0, 0.0);
   EXPECT_NEAR(pass.volume_drift_mm3, v0 - v1 - pass.removed_mm3, 1e-9 * v0);
   EXPECT_NEAR(pass.volume_drift_myoma_mm3, myoma0 - myoma1 - pass.removed_myoma_mm3, 1e-9 * v0);
+  EXPECT_GE(pass.peeled_mm3, 0.0);
 
   RunReport report;
   report.passes = {pass, pass};
   report.passes[1].volume_drift_mm3 = 0.5;
   report.passes[1].volume_drift_myoma_mm3 = 0.25;
+  report.passes[1].peeled_mm3 = 0.125;
   const RunSummary sum = summarize(report);
   EXPECT_DOUBLE_EQ(sum.volume_drift_mm3, pass.volume_drift_mm3 + 0.5);
   EXPECT_DOUBLE_EQ(sum.volume_drift_myoma_mm3, pass.volume_drift_myoma_mm3 + 0.25);
   EXPECT_DOUBLE_EQ(sum.volume_drift_healthy_mm3, sum.volume_drift_mm3 - sum.volume_drift_myoma_mm3);
+  EXPECT_DOUBLE_EQ(sum.peeled_mm3, pass.peeled_mm3 + 0.125);
 }
 
 // While the active loop moves through the tissue (entry at ~175 steps, exit at ~925) the
