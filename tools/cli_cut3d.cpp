@@ -115,8 +115,14 @@ int runCut3d(const Cut3dArgs& a) {
     nlohmann::ordered_json vols = nlohmann::ordered_json::array();
     for (double v : comps.volume) vols.push_back(v);
     j["component_volumes"] = vols;
-    j["volume_before"] = cutting::totalVolume(*mesh);
-    j["volume_after"] = cutting::totalVolume(res->mesh);
+    j["volume_before"] = r.volume_before;
+    j["volume_after"] = r.volume_after;
+    j["volume_drift"] = r.volume_drift;
+    j["cut_off_volume"] = r.cut_off_volume;
+    nlohmann::ordered_json materials = nlohmann::ordered_json::array();
+    for (const cutting::MaterialVolume& m : r.material_volumes)
+      materials.push_back({{"label", m.label}, {"before", m.before}, {"after", m.after}, {"drift", m.drift()}});
+    j["material_volumes"] = materials;
     std::ofstream out(a.stats);
     if (!out) return fail("cannot write '" + a.stats + "'");
     out << j.dump(2) << "\n";

@@ -1443,7 +1443,10 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
     optimizeAroundCut(out, region, options.optimize, &moved, &peeled, &counts);
     if (region.left_alone != nullptr)
       for (size_t t = 0; t < cutOffTets.size(); ++t)
-        if (cutOffTets[t]) peeled[t] = 0;
+        if (cutOffTets[t]) {
+          peeled[t] = 0;
+          report.cut_off_volume += tetVolume(out, t);
+        }
     report.optimize_iterations = counts.iterations;
     report.peeled_elements = counts.peeled;
     report.flap_peeled = counts.flap_peeled;
@@ -1611,6 +1614,13 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
   change.new_num_nodes = out.numNodes();
   change.new_num_elements = out.numTets();
   lap(report.compact_ms);
+  // Volume kept: every tet of the input and the output, per material.
+  report.material_volumes = materialVolumes(input, out);
+  for (const MaterialVolume& m : report.material_volumes) {
+    report.volume_before += m.before;
+    report.volume_after += m.after;
+  }
+  report.volume_drift = report.volume_before - report.volume_after;
   return result;
 }
 

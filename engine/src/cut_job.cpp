@@ -409,6 +409,10 @@ void runCutJob(const Tissue& base, const Scene& scene, const CutJobInput& in, Cu
   rec.duplicated_nodes = cut->report.duplicated_nodes;
   rec.unoptimised_chip_elements = cut->report.cut_off_elements;
   rec.cut_faces = cut->report.cut_faces;
+  rec.volume_drift_mm3 = cut->report.volume_drift;
+  rec.peeled_mm3 = cut->report.peeled_volume;
+  for (const cutting::MaterialVolume& m : cut->report.material_volumes)
+    if (m.label == myomaLabel(scene)) rec.volume_drift_myoma_mm3 = m.drift();
 
   Kept k;
   k.anchored_after = anchorsAfter(base, scene, after, change);

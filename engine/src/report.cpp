@@ -28,10 +28,14 @@ RunSummary summarize(const RunReport& r) {
   for (const PassRecord& p : r.passes) {
     s.myoma_resected_mm3 += p.removed_myoma_mm3;
     removed += p.removed_mm3;
+    s.volume_drift_mm3 += p.volume_drift_mm3;
+    s.volume_drift_myoma_mm3 += p.volume_drift_myoma_mm3;
+    s.peeled_mm3 += p.peeled_mm3;
     cut_ms.push_back(p.cut_ms);
   }
   s.myoma_resected_pct = r.initial_myoma_mm3 > 0.0 ? 100.0 * s.myoma_resected_mm3 / r.initial_myoma_mm3 : 0.0;
   s.healthy_removed_mm3 = removed - s.myoma_resected_mm3;
+  s.volume_drift_healthy_mm3 = s.volume_drift_mm3 - s.volume_drift_myoma_mm3;
   s.perforations = r.perforations;
   s.passes = static_cast<int>(r.passes.size());
   s.electrode_active_s = r.electrode_active_s;
@@ -117,6 +121,9 @@ std::string reportJson(const RunReport& r) {
     e["chips"] = p.chips;
     e["removed_mm3"] = p.removed_mm3;
     e["removed_myoma_mm3"] = p.removed_myoma_mm3;
+    e["volume_drift_mm3"] = p.volume_drift_mm3;
+    e["volume_drift_myoma_mm3"] = p.volume_drift_myoma_mm3;
+    e["peeled_mm3"] = p.peeled_mm3;
     e["sweep_area_mm2"] = p.sweep_area_mm2;
     e["crossed_edges"] = p.crossed_edges;
     e["snapped_nodes"] = p.snapped_nodes;
@@ -136,6 +143,10 @@ std::string reportJson(const RunReport& r) {
   j["myoma_resected_mm3"] = sum.myoma_resected_mm3;
   j["myoma_resected_pct"] = sum.myoma_resected_pct;
   j["healthy_removed_mm3"] = sum.healthy_removed_mm3;
+  j["volume_drift_mm3"] = sum.volume_drift_mm3;
+  j["volume_drift_myoma_mm3"] = sum.volume_drift_myoma_mm3;
+  j["volume_drift_healthy_mm3"] = sum.volume_drift_healthy_mm3;
+  j["peeled_mm3"] = sum.peeled_mm3;
   j["electrode_active_s"] = r.electrode_active_s;
   j["path_length_mm"] = r.path_length_mm;
   j["passes"] = r.passes.size();

@@ -304,6 +304,52 @@ TEST(Cut3D, RandomizedPlanesAllMethods) {
   }
 }
 
+// The report's volume kept: the input's and output's volumes, per material and in all, and
+// their difference; a flat-sided box cut by planes without the optimisation loses nothing.
+TEST(Cut3D, ReportsTheVolumeKept) {
+  TetMesh box = testing::boxTetMesh(5, 3, 4, 0.7);
+  for (int t = 0; t < box.numTets(); ++t) {  // two materials: the tets left and right of x = 1.4
+    double x = 0;
+    for (int k = 0; k < 4; ++k) x += 0.25 * box.X(box.T(t, k), 0);
+    box.material(t) = x < 1.4 ? 3 : 7;
+  }
+  auto labelVolume = [](const TetMesh& m, int label) {
+    double v = 0;
+    for (int t = 0; t < m.numTets(); ++t) v += m.material(t) == label ? tetVolume(m, t) : 0.0;
+    return v;
+  };
+  const double v0 = totalVolume(box);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int trial = 0; trial < 8; ++trial) {
+    SCOPED_TRACE(trial);
+    const Vec3 p(1.75 + 0.5 * u(rng), 1.05 + 0.3 * u(rng), 1.4 + 0.4 * u(rng)), n(u(rng), u(rng), u(rng));
+    for (const bool optimise : {false, true}) {
+      Cut3DOptions o;
+      o.optimize.enabled = optimise;
+      const auto r = cut3d(box, *CutSurface::plane(p, n), o);
+      ASSERT_TRUE(r.ok()) << r.error();
+      const Cut3DReport& rep = r->report;
+      EXPECT_NEAR(rep.volume_before, v0, 1e-12 * v0);
+      EXPECT_NEAR(rep.volume_after, totalVolume(r->mesh), 1e-12 * v0);
+      EXPECT_DOUBLE_EQ(rep.volume_drift, rep.volume_before - rep.volume_after);
+      ASSERT_EQ(rep.material_volumes.size(), 2u);
+      double drift = 0;
+      for (const MaterialVolume& m : rep.material_volumes) {
+        EXPECT_NEAR(m.before, labelVolume(box, m.label), 1e-12 * v0);
+        EXPECT_NEAR(m.after, labelVolume(r->mesh, m.label), 1e-12 * v0);
+        drift += m.drift();
+      }
+      EXPECT_EQ(rep.material_volumes[0].label, 3);
+      EXPECT_EQ(rep.material_volumes[1].label, 7);
+      EXPECT_NEAR(drift, rep.volume_drift, 1e-12 * v0);
+      if (!optimise) {
+        EXPECT_LE(std::abs(rep.volume_drift), 1e-9 * v0);
+      }
+    }
+  }
+}
+
 // --- triangulated cut surfaces -----------------------------------------------------------
 
 // A strip of a cylinder (axis along y, radius R, centred at c), the loop's swept surface.
@@ -811,6 +857,7 @@ TEST(Cut3D, CutOffPiecesAreLeftAsCut) {
   EXPECT_EQ(r->report.cut_off_elements, c.elements[cap]);
   EXPECT_EQ(c.elements[cap], bareC.elements[bareCap]);
   EXPECT_NEAR(c.volume[cap], bareC.volume[bareCap], 1e-12 * bareC.volume[bareCap]);
+  EXPECT_NEAR(r->report.cut_off_volume, c.volume[cap], 1e-12 * c.volume[cap]);
   // The cap's tets, as sorted corner positions, are the unoptimised cut's.
   auto capTets = [](const TetMesh& m, const Components3D& comps, int label) {
     std::vector<std::array<double, 12>> out;

@@ -60,6 +60,46 @@ TEST(Shaving, OnePassThroughASlabCutsOnExit) {
   EXPECT_EQ((*sim)->state().warnings, 0);
 }
 
+// A pass reports the volume its cut lost: the tissue's volume before the pass less its
+// volume after and the chips', in all and of the myoma; the run's total is the passes' sum.
+TEST(Shaving, PassReportsTheVolumeItsCutLost) {
+  auto scene = loadScene(writeSlabScene(true));
+  ASSERT_TRUE(scene.ok()) << scene.error();
+  auto sim = Simulation::create(*scene);
+  ASSERT_TRUE(sim.ok()) << sim.error();
+  const cutting::TetMesh before = (*sim)->mesh();
+  for (int i = 0; i < 1300; ++i) (*sim)->step();
+  ASSERT_EQ((*sim)->passes().size(), 1u);
+  const PassRecord& pass = (*sim)->passes()[0];
+  ASSERT_FALSE(pass.cut_failed) << pass.message;
+  ASSERT_EQ(pass.chips, 1);
+  const std::vector<cutting::MaterialVolume> kept = cutting::materialVolumes(before, (*sim)->mesh());
+  double v0 = 0, v1 = 0, myoma0 = 0, myoma1 = 0;
+  for (const cutting::MaterialVolume& m : kept) {
+    v0 += m.before;
+    v1 += m.after;
+    if (m.label == 1) {  // the slab scene's myoma
+      myoma0 += m.before;
+      myoma1 += m.after;
+    }
+  }
+  ASSERT_GT(myoma0, 0.0);
+  EXPECT_NEAR(pass.volume_drift_mm3, v0 - v1 - pass.removed_mm3, 1e-9 * v0);
+  EXPECT_NEAR(pass.volume_drift_myoma_mm3, myoma0 - myoma1 - pass.removed_myoma_mm3, 1e-9 * v0);
+  EXPECT_GE(pass.peeled_mm3, 0.0);
+
+  RunReport report;
+  report.passes = {pass, pass};
+  report.passes[1].volume_drift_mm3 = 0.5;
+  report.passes[1].volume_drift_myoma_mm3 = 0.25;
+  report.passes[1].peeled_mm3 = 0.125;
+  const RunSummary sum = summarize(report);
+  EXPECT_DOUBLE_EQ(sum.volume_drift_mm3, pass.volume_drift_mm3 + 0.5);
+  EXPECT_DOUBLE_EQ(sum.volume_drift_myoma_mm3, pass.volume_drift_myoma_mm3 + 0.25);
+  EXPECT_DOUBLE_EQ(sum.volume_drift_healthy_mm3, sum.volume_drift_mm3 - sum.volume_drift_myoma_mm3);
+  EXPECT_DOUBLE_EQ(sum.peeled_mm3, pass.peeled_mm3 + 0.125);
+}
+
 // While the active loop moves through the tissue (entry at ~175 steps, exit at ~925) the
 // step allocates nothing: the sweep and the tet locator reuse their storage.
 TEST(Shaving, StepAllocatesNothingWhileCutting) {

@@ -69,7 +69,8 @@ nlohmann::json checkStats(const std::string& path) {
   EXPECT_FALSE(j.is_discarded()) << path;
   if (j.is_discarded()) return j;
   for (const char* key : kStatsKeys) EXPECT_TRUE(j.contains(key)) << key;
-  for (const char* key : {"time_ms", "components", "method", "volume_before", "volume_after"})
+  for (const char* key : {"time_ms", "components", "method", "volume_before", "volume_after", "volume_drift",
+                          "material_volumes"})
     EXPECT_TRUE(j.contains(key)) << key;
   EXPECT_GT(j.value("time_ms", 0.0), 0.0);
   return j;
@@ -88,6 +89,7 @@ TEST(CliCut3D, PlaneCutEveryMethod) {
     EXPECT_EQ(j["method"], method);
     EXPECT_GE(j["components"].get<int>(), 2);  // the plane passes through the middle: two pieces
     const double v0 = j["volume_before"].get<double>(), v1 = j["volume_after"].get<double>();
+    EXPECT_NEAR(j["volume_drift"].get<double>(), v0 - v1, 1e-12 * v0);
     if (method == "standard") {
       EXPECT_NEAR(v1, v0, 1e-9 * v0);
     } else if (method == "hybrid") {

@@ -22,6 +22,7 @@
 //     connected;
 //  5. hybrid: local optimisation (see Optimize3DOptions).
 #include <Eigen/Core>
+#include <cstdint>
 #include <functional>
 #include <vector>
 
@@ -209,6 +210,13 @@ struct Cut3DOptions {
   int free_piece_search_limit = 20000;
 };
 
+// One material label's volume in the input and output mesh of a cut (Cut3DReport).
+struct MaterialVolume {
+  std::int32_t label = 0;  // TetMesh::material
+  double before = 0, after = 0;
+  double drift() const { return before - after; }
+};
+
 struct Cut3DReport {
   int crossed_edges = 0;      // before any snapping
   int crossed_elements = 0;   // tets with nodes strictly on both sides
@@ -234,6 +242,12 @@ struct Cut3DReport {
   int optimize_iterations = 0;
   int cut_off_pieces = 0;     // pieces left out of the optimisation (anchored_nodes)
   int cut_off_elements = 0;   // their tets
+  double cut_off_volume = 0;  // their volume (in volume_after: they stay in the output)
+  // Volume kept: the output holds every piece, detached ones included, so what the input
+  // had and the output lacks is tissue the cut lost, peeled slivers and flaps included
+  // (peeled_volume); positive: lost. Per material label, ascending by label.
+  double volume_before = 0, volume_after = 0, volume_drift = 0;
+  std::vector<MaterialVolume> material_volumes;
   double cut_ms = 0, optimize_ms = 0;
   // Wall time of the steps (ms), for profiling: classification (with the node -> tets lists
   // and the work arrays), snapping (with moving away and routing), subdivision, separation,
@@ -267,6 +281,9 @@ struct Components3D {
 Components3D tetComponents(const TetMesh& mesh, const std::vector<int>& anchored = {});
 
 double totalVolume(const TetMesh& mesh);
+// Each material label's volume in two meshes (a cut's input and output), ascending by label;
+// a label missing from one mesh has volume 0 there (material_volumes.cpp).
+std::vector<MaterialVolume> materialVolumes(const TetMesh& before, const TetMesh& after);
 
 // Largest signed distance by which a tet has nodes strictly on both sides of a plane, as a
 // check: returns the number of tets with a node > eps and a node < -eps.

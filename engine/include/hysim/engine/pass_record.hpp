@@ -32,6 +32,10 @@ struct PassRecord {
   int chips = 0;             // free pieces removed
   double removed_mm3 = 0.0;  // volume of the removed chips
   double removed_myoma_mm3 = 0.0;
+  // Volume the cut lost (Cut3DReport::volume_drift: its input less its output, chips
+  // included, so they are no drift; peeled slivers and flaps are); positive: lost.
+  double volume_drift_mm3 = 0.0, volume_drift_myoma_mm3 = 0.0;
+  double peeled_mm3 = 0.0;  // of the drift: slivers and flaps the optimisation removed (Cut3DReport::peeled_volume)
   double sweep_area_mm2 = 0.0;  // area of the cut surface (the loop's sweep)
   int crossed_edges = 0, snapped_nodes = 0, split_edges = 0, duplicated_nodes = 0, cut_faces = 0;
   int unoptimised_chip_elements = 0;  // chips.optimize false: the tets the cut left as cut

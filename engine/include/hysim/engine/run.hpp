@@ -97,6 +97,9 @@ struct RunSummary {
   double myoma_resected_mm3 = 0.0;
   double myoma_resected_pct = 0.0;  // of the initial myoma volume
   double healthy_removed_mm3 = 0.0;
+  double volume_drift_mm3 = 0.0, volume_drift_myoma_mm3 = 0.0;  // sums of the passes' (PassRecord)
+  double volume_drift_healthy_mm3 = 0.0;                        // the non-myoma part
+  double peeled_mm3 = 0.0;                                      // of the drift: peeled (PassRecord)
   int perforations = 0;
   int passes = 0;
   double electrode_active_s = 0.0;
