@@ -121,8 +121,8 @@ inline CorpusCut corpusPlane(const cutting::TetMesh& m, int mesh, int k, std::ui
 
 // Curved case k of mesh `mesh` (kind surfaceKind(k)). Complete patches reach every point of
 // the bounding box around their point c (angle and length from the box diagonal), so they
-// cut the mesh through; partial ones span about a fifth of the box's shortest side around
-// c (in the middle 20%), so they end inside the mesh.
+// cut the mesh through; partial ones span 0.4 of the box's shortest side around c (in the
+// middle 20%), so they end inside the mesh.
 inline CorpusCut corpusSurface(const cutting::TetMesh& m, int mesh, int k, std::uint64_t seed = 34) {
   const Eigen::AlignedBox3d box(m.X.colwise().minCoeff().transpose(), m.X.colwise().maxCoeff().transpose());
   const double diag = box.diagonal().norm(), shortest = box.sizes().minCoeff();
@@ -140,10 +140,10 @@ inline CorpusCut corpusSurface(const cutting::TetMesh& m, int mesh, int k, std::
   const double turn = std::uniform_real_distribution<double>(0, M_PI)(rng);
   axis = Eigen::AngleAxisd(turn, cut.normal) * axis;
   // A chord of length d from c subtends 2 asin(d / 2R) at the centre.
-  const double reach = complete ? 1.05 * diag : 0.1 * shortest;
+  const double reach = complete ? 1.05 * diag : 0.2 * shortest;
   const double angle = 2 * std::asin(std::min(1.0, reach / (2 * R)));
-  const double halfLength = complete ? 1.05 * diag : 0.1 * shortest;
-  detail::curvedPatch(sphere, cut.point, cut.normal, axis, R, angle, halfLength, complete ? 64 : 16, &cut.X, &cut.F);
+  const double halfLength = complete ? 1.05 * diag : 0.2 * shortest;
+  detail::curvedPatch(sphere, cut.point, cut.normal, axis, R, angle, halfLength, complete ? 64 : 24, &cut.X, &cut.F);
   return cut;
 }
 
