@@ -110,6 +110,8 @@ int runCut3d(const Cut3dArgs& a) {
     j["peeled_elements"] = r.peeled_elements;
     j["flap_peeled"] = r.flap_peeled;
     j["peeled_volume"] = r.peeled_volume;
+    j["volume_restored"] = r.volume_restored;
+    j["volume_moves"] = r.volume_moves;
     j["method"] = cutting::cutMethodName(o.method);
     j["components"] = comps.count;
     nlohmann::ordered_json vols = nlohmann::ordered_json::array();

@@ -1384,6 +1384,7 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
 
   lap(report.assemble_ms);
   std::vector<std::uint8_t> peeled;  // #M1: slivers the optimisation removed
+  std::vector<MaterialVolume> inputVolumes;  // per label (volume kept)
   // 5. Local optimisation (hybrid), from the nodes the cut created, moved or separated.
   // (Also when the surface split edges but made no cut face, e.g. a sweep's edge grazing the
   // tissue: the splits may leave slivers; then the new nodes are the seeds.)
@@ -1416,6 +1417,8 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
     }
 #endif
     region.stars = &stars;
+    inputVolumes = materialVolumes(input);
+    region.volume_target = inputVolumes;
     // The pieces cut off (options.anchored_nodes) are left as they are: no seeds there, and
     // their tets are dead to the optimisation (unmarked in `peeled` after it).
     std::vector<std::uint8_t> cutOffTets, cutOffNodes;
@@ -1458,6 +1461,8 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
     std::sort(cutNodes.begin() + mid, cutNodes.end());
     std::inplace_merge(cutNodes.begin(), cutNodes.begin() + mid, cutNodes.end());
     report.peeled_volume = counts.peeled_volume;
+    report.volume_restored = counts.volume_restored;
+    report.volume_moves = counts.volume_moves;
     report.optimized_nodes = static_cast<int>(moved.size() - before);
     report.optimize_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - optStart).count();
     report.collapse_ms = counts.collapse_ms;
@@ -1615,7 +1620,9 @@ Result<Cut3DResult> cut3d(const TetMesh& input, const CutSurface& surface, const
   change.new_num_elements = out.numTets();
   lap(report.compact_ms);
   // Volume kept: every tet of the input and the output, per material.
-  report.material_volumes = materialVolumes(input, out);
+  if (inputVolumes.empty()) inputVolumes = materialVolumes(input);
+  addVolumesAfter(out, &inputVolumes);
+  report.material_volumes = std::move(inputVolumes);
   for (const MaterialVolume& m : report.material_volumes) {
     report.volume_before += m.before;
     report.volume_after += m.after;

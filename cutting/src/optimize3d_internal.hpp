@@ -68,7 +68,16 @@ struct CutRegion {
   // Optional (#T): tets left as they are (pieces the cut cut off), as if already removed:
   // no operation reads or changes them. They start marked in *dead (the caller unmarks them).
   const std::vector<std::uint8_t>* left_alone = nullptr;
+  // Optional: per material label, ascending, the volume the output keeps (`before`: the cut's
+  // input); empty: the volumes the mesh has when the optimisation starts.
+  std::vector<MaterialVolume> volume_target;
 };
+
+// Adds, per material label, the volume of mesh's tets to `field` of *volumes (ascending by
+// label), skipping the tets marked in *skip unless marked in *keepAnyway (material_volumes.cpp).
+void addMaterialVolumes(const TetMesh& mesh, double MaterialVolume::*field, std::vector<MaterialVolume>* volumes,
+                        const std::vector<std::uint8_t>* skip = nullptr,
+                        const std::vector<std::uint8_t>* keepAnyway = nullptr);
 
 struct OptimizeCounts {
   int iterations = 0;
@@ -79,6 +88,8 @@ struct OptimizeCounts {
   int flap_peeled = 0;  // of peeled: in flaps (flap_peel.cpp)
   std::vector<std::int32_t> onto_cut;  // the nodes late snapping moved onto the cut
   double peeled_volume = 0;
+  double volume_restored = 0;  // keep_volume: the volume put back (net, all labels)
+  int volume_moves = 0;
   double collapse_ms = 0, late_snap_ms = 0, move_ms = 0;  // wall time of those steps
 };
 

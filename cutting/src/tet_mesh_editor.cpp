@@ -8,21 +8,9 @@
 #include <iterator>
 
 #include "hysim/cutting/mesh_stats.hpp"
+#include "tet_geometry_inline.hpp"
 
 namespace hysim::cutting {
-namespace {
-
-// v[0, mid) and v[mid, end), each sorted, into one sorted list without repeats.
-void mergeRuns(std::vector<std::int32_t>& v, size_t mid, std::vector<std::int32_t>& scratch) {
-  scratch.clear();
-  const auto m = v.begin() + static_cast<std::ptrdiff_t>(mid);
-  std::merge(v.begin(), m, m, v.end(), std::back_inserter(scratch));
-  scratch.erase(std::unique(scratch.begin(), scratch.end()), scratch.end());
-  v.swap(scratch);
-}
-
-}  // namespace
-
 TetMeshEditor::TetMeshEditor(TetMesh& mesh, std::vector<std::uint8_t>& dead, StarLists* stars)
     : mesh_(mesh), dead_(dead) {
   const int N = mesh.numNodes(), M = mesh.numTets();
@@ -72,7 +60,7 @@ void TetMeshEditor::refreshStars() {
     if (g != gained_.end() && g->first == n) {
       const size_t mid = scratch_.size();
       for (; g != gained_.end() && g->first == n; ++g) scratch_.push_back(g->second);
-      mergeRuns(scratch_, mid, scratch2_);
+      mergeSortedRuns(scratch_, mid, scratch2_);
     }
 #ifdef HYSIM_CHECK_EXACT
     if (std::adjacent_find(scratch_.begin(), scratch_.end(), std::greater_equal<std::int32_t>()) != scratch_.end())
@@ -112,61 +100,44 @@ void TetMeshEditor::setTetNodes(int t, int a, int b, int c, int d) {
   }
 }
 
-double TetMeshEditor::quality(int t) {
-  QEntry cur;
+TetMeshEditor::QEntry TetMeshEditor::keyOf(int t) const {
+  QEntry key;
   for (int k = 0; k < 4; ++k) {
-    cur.v[k] = mesh_.T(t, k);
-    cur.ver[k] = nodeVer_[cur.v[k]];
+    key.v[k] = mesh_.T(t, k);
+    key.ver[k] = nodeVer_[key.v[k]];
   }
-  std::int32_t& slot = qSlot_[t];
-  if (slot >= 0) {
-    const QEntry& e = qPool_[slot];
-    if (std::equal(cur.v, cur.v + 4, e.v) && std::equal(cur.ver, cur.ver + 4, e.ver)) return e.q;
-  } else {
-    slot = qNext_++;
-  }
-  cur.q = radiusRatio(position(cur.v[0]), position(cur.v[1]), position(cur.v[2]), position(cur.v[3]));
-  cur.up = -1;
-  qPool_[slot] = cur;
-  return cur.q;
+  return key;
 }
 
-namespace {
-// Six times tetVolume, in scalars over the coordinate columns (the same value as
-// (x1 - x0).dot((x2 - x0).cross(x3 - x0))).
-inline double volume6(const TetMesh& mesh, int t) {
-  const double* cx = mesh.X.col(0).data();
-  const double* cy = mesh.X.col(1).data();
-  const double* cz = mesh.X.col(2).data();
-  const int i0 = mesh.T(t, 0), i1 = mesh.T(t, 1), i2 = mesh.T(t, 2), i3 = mesh.T(t, 3);
-  const double ax = cx[i1] - cx[i0], ay = cy[i1] - cy[i0], az = cz[i1] - cz[i0];
-  const double bx = cx[i2] - cx[i0], by = cy[i2] - cy[i0], bz = cz[i2] - cz[i0];
-  const double ex = cx[i3] - cx[i0], ey = cy[i3] - cy[i0], ez = cz[i3] - cz[i0];
-  const double nx = by * ez - bz * ey, ny = bz * ex - bx * ez, nz = bx * ey - by * ex;
-  return (ax * nx + ay * ny) + az * nz;
+TetMeshEditor::QEntry* TetMeshEditor::cached(int t, const QEntry& key) {
+  const std::int32_t slot = qSlot_[t];
+  if (slot < 0) return nullptr;
+  QEntry& e = qPool_[slot];
+  return std::equal(key.v, key.v + 4, e.v) && std::equal(key.ver, key.ver + 4, e.ver) ? &e : nullptr;
 }
-}  // namespace
+
+double TetMeshEditor::store(int t, QEntry entry, std::int8_t up) {
+  if (qSlot_[t] < 0) qSlot_[t] = qNext_++;
+  entry.q = radiusRatio(position(entry.v[0]), position(entry.v[1]), position(entry.v[2]), position(entry.v[3]));
+  entry.up = up;
+  qPool_[qSlot_[t]] = entry;
+  return entry.q;
+}
+
+double TetMeshEditor::quality(int t) {
+  const QEntry key = keyOf(t);
+  if (const QEntry* e = cached(t, key)) return e->q;
+  return store(t, key, -1);
+}
 
 double TetMeshEditor::qualityIfPositive(int t) {
-  QEntry cur;
-  for (int k = 0; k < 4; ++k) {
-    cur.v[k] = mesh_.T(t, k);
-    cur.ver[k] = nodeVer_[cur.v[k]];
+  const QEntry key = keyOf(t);
+  if (QEntry* e = cached(t, key)) {
+    if (e->up < 0) e->up = tetVolume6Here(mesh_, t) > 0 ? 1 : 0;
+    return e->up ? e->q : -1.0;
   }
-  std::int32_t& slot = qSlot_[t];
-  if (slot >= 0) {
-    QEntry& e = qPool_[slot];
-    if (std::equal(cur.v, cur.v + 4, e.v) && std::equal(cur.ver, cur.ver + 4, e.ver)) {
-      if (e.up < 0) e.up = volume6(mesh_, t) > 0 ? 1 : 0;
-      return e.up ? e.q : -1.0;
-    }
-  }
-  if (!(volume6(mesh_, t) > 0)) return -1.0;
-  if (slot < 0) slot = qNext_++;
-  cur.q = radiusRatio(position(cur.v[0]), position(cur.v[1]), position(cur.v[2]), position(cur.v[3]));
-  cur.up = 1;
-  qPool_[slot] = cur;
-  return cur.q;
+  if (!(tetVolume6Here(mesh_, t) > 0)) return -1.0;
+  return store(t, key, 1);
 }
 
 double TetMeshEditor::qualityWith(int t, int n, const Vec3& y) const {

@@ -4,6 +4,8 @@
 #include <array>
 #include <string>
 
+#include <Eigen/Geometry>
+
 #include "hysim/cutting/mesh_stats.hpp"
 #include "hysim/cutting/tet_mesh_editor.hpp"
 
@@ -136,6 +138,14 @@ int TetMeshEditor::splitEdge(int a, int b, double w) {
 }
 
 bool TetMeshEditor::moveNode(int n, const Vec3& y, double floor) {
+  if (!moveAllowed(n, y, floor)) return false;
+  setPosition(n, y);
+  ensureTracking();
+  if (nodeOrigin_[n] >= 0) movedFlag_[n] = 1;
+  return true;
+}
+
+bool TetMeshEditor::moveAllowed(int n, const Vec3& y, double floor) {
   if (!y.allFinite()) return false;
   double before = 1.0;
   for (const std::int32_t *s = starBegin(n), *e = starEnd(n); s < e; ++s)
@@ -146,9 +156,6 @@ bool TetMeshEditor::moveNode(int n, const Vec3& y, double floor) {
     const double q = qualityWith(*s, n, y);
     if (q < 0 || q < bound) return false;
   }
-  setPosition(n, y);
-  ensureTracking();
-  if (nodeOrigin_[n] >= 0) movedFlag_[n] = 1;
   return true;
 }
 

@@ -343,8 +343,11 @@ TEST(Cut3D, ReportsTheVolumeKept) {
       EXPECT_EQ(rep.material_volumes[0].label, 3);
       EXPECT_EQ(rep.material_volumes[1].label, 7);
       EXPECT_NEAR(drift, rep.volume_drift, 1e-12 * v0);
-      if (!optimise) {
-        EXPECT_LE(std::abs(rep.volume_drift), 1e-9 * v0);
+      // Snapping keeps the total (it may move the interface between the materials); the
+      // optimisation makes up for what it and the snaps changed, per material.
+      EXPECT_LE(std::abs(rep.volume_drift), (optimise ? 1e-5 : 1e-9) * v0);
+      if (optimise) {
+        for (const MaterialVolume& m : rep.material_volumes) EXPECT_LE(std::abs(m.drift()), 1e-5 * v0) << m.label;
       }
     }
   }

@@ -51,7 +51,7 @@ void randomPlanes(const TetMesh& mesh, int planes, const Cut3DOptions& options, 
     *routed += r->report.routed_nodes;
     *deviation = std::max(*deviation, r->report.max_route_deviation_mm);
     EXPECT_LE(r->mesh.numTets(), 1.10 * mesh.numTets()) << "plane " << p;
-    EXPECT_NEAR(totalVolume(r->mesh), v0, 1e-3 * v0) << "plane " << p;
+    EXPECT_NEAR(totalVolume(r->mesh), v0, 1e-5 * v0) << "plane " << p;
     for (int t = 0; t < r->mesh.numTets(); ++t) ASSERT_GT(tetVolume(r->mesh, t), 0.0);
     const auto s = computeStats(r->mesh);
     *worstQ = std::min(*worstQ, s.q_min / s0.q_min);

@@ -87,6 +87,8 @@ TEST(Shaving, PassReportsTheVolumeItsCutLost) {
   EXPECT_NEAR(pass.volume_drift_mm3, v0 - v1 - pass.removed_mm3, 1e-9 * v0);
   EXPECT_NEAR(pass.volume_drift_myoma_mm3, myoma0 - myoma1 - pass.removed_myoma_mm3, 1e-9 * v0);
   EXPECT_GE(pass.peeled_mm3, 0.0);
+  EXPECT_LE(std::abs(pass.volume_drift_mm3), 1e-5 * v0);
+  EXPECT_LE(std::abs(pass.volume_drift_myoma_mm3), 1e-5 * v0);
 
   RunReport report;
   report.passes = {pass, pass};

@@ -3,6 +3,7 @@
 // paper's 2D regularisation carried to 3D). optimizeAroundCut (pipeline.cpp) runs:
 //   repair region -> peel -> snap near -> collapse -> flips -> smooth (iterated)
 //   -> snap near -> collapse -> flips -> peel -> (curved cuts) flap peel -> last-resort collapse
+//   -> keep volume (each material's volume back to the cut's input's)
 // One file per stage; the shared pieces: constraints.cpp (where a node may move), manifold.cpp
 // (boundary faces, disc checks), region.cpp (which tets and nodes take part).
 //
@@ -14,7 +15,10 @@
 //    volume is linear in one node's position with gradient (1/3) x the sum of its boundary
 //    faces' area vectors, so such a move keeps the volume exactly);
 //  - on curved cuts (shaving), more within volume budgets: curved boundaries, ridges (the rim
-//    where the cut meets the boundary, creases), flips, collapses off the cut.
+//    where the cut meets the boundary, creases), flips, collapses off the cut;
+//  - nodes between materials only perpendicular to each material's volume gradient;
+//  - last, boundary nodes off the cut along their volume gradients, to give back what the
+//    stages before lost or gained (keep_volume.cpp).
 #include <array>
 #include <chrono>
 #include <cmath>
@@ -24,7 +28,10 @@
 #include <limits>
 #include <vector>
 
+#include <Eigen/Geometry>
+
 #include "../optimize3d_internal.hpp"
+#include "../tet_geometry_inline.hpp"
 #include "hysim/cutting/tet_mesh_editor.hpp"
 
 namespace hysim::cutting::opt3d {
@@ -210,6 +217,14 @@ class CutOptimizer {
   bool linkIsOneLoop(std::int32_t L);
   // peel.cpp
   void peel();
+  // keep_volume.cpp
+  void keepVolume();
+  bool leftAlone(int t) const;
+  void volumesNow(std::vector<MaterialVolume>& volumes, double MaterialVolume::*field) const;
+  void volumeMovers(std::int32_t label, int rings, std::vector<std::int32_t>& nodes);
+  Vec3 labelGradient(int n, std::int32_t label) const;
+  double starVolumeOf(int n) const;
+  double volumeSweep(std::int32_t label, double deficit, std::vector<std::int32_t>& movers, std::vector<Vec3>& from);
   // flips.cpp
   void flips();
   void flipCandidates(int round, std::vector<std::int32_t>& cands);
@@ -263,6 +278,7 @@ class CutOptimizer {
   void moveRun(const std::vector<std::int32_t>& list);
   // starAbove (smooth.cpp): is the worst q* around n with n at y above floor?
   bool starAbove(int n, const Vec3& y, int first, double firstQ, double floor, double* q);
+  void keepMaterials(MoveTry& mt);
 
   TetMesh& mesh;
   const CutRegion& region;
@@ -281,6 +297,7 @@ class CutOptimizer {
   double meshVolume = 0, edgeTet = 0, refVolume = 0;
   VolumeBudget budget, moveBudget;
   std::vector<MatVol> matVol;
+  std::vector<MaterialVolume> startVolumes;  // keep_volume without region.volume_target
 
   // Seeds and region (region.cpp).
   std::vector<std::int32_t> seeds, lateSnapped, around;
@@ -332,37 +349,5 @@ class CutOptimizer {
   std::vector<std::int32_t> adjOff, adj, rankOf, reach, below, partA, partB, partS, moveRest;
   std::vector<std::pair<double, std::int32_t>> keyed;
 };
-
-// Six times tetVolume (mesh.cpp), inlined, in scalars over the coordinate columns: Eigen's
-// cross (y1 z2 - z1 y2, z1 x2 - x1 z2, x1 y2 - y1 x2) and 3-vector dot ((a0 b0 + a1 b1) +
-// a2 b2), the same value as (x1 - x0).dot((x2 - x0).cross(x3 - x0)) (checked bit for bit).
-inline double tetVolume6Here(const TetMesh& mesh, int t) {
-  const double* cx = mesh.X.col(0).data();
-  const double* cy = mesh.X.col(1).data();
-  const double* cz = mesh.X.col(2).data();
-  const int i0 = mesh.T(t, 0), i1 = mesh.T(t, 1), i2 = mesh.T(t, 2), i3 = mesh.T(t, 3);
-  const double ax = cx[i1] - cx[i0], ay = cy[i1] - cy[i0], az = cz[i1] - cz[i0];
-  const double bx = cx[i2] - cx[i0], by = cy[i2] - cy[i0], bz = cz[i2] - cz[i0];
-  const double ex = cx[i3] - cx[i0], ey = cy[i3] - cy[i0], ez = cz[i3] - cz[i0];
-  const double nx = by * ez - bz * ey, ny = bz * ex - bx * ez, nz = bx * ey - by * ex;
-  const double v6 = (ax * nx + ay * ny) + az * nz;
-#ifdef HYSIM_CHECK_EXACT
-  const Eigen::Vector3d x0 = mesh.X.row(i0), x1 = mesh.X.row(i1), x2 = mesh.X.row(i2), x3 = mesh.X.row(i3);
-  const double ref = (x1 - x0).dot((x2 - x0).cross(x3 - x0));
-  if (std::memcmp(&ref, &v6, sizeof v6) != 0) std::abort();
-#endif
-  return v6;
-}
-// tetVolume (mesh.cpp) inlined: the same value.
-inline double tetVolumeHere(const TetMesh& mesh, int t) {
-  const double v = tetVolume6Here(mesh, t) / 6.0;
-#ifdef HYSIM_CHECK_EXACT
-  const double ref = tetVolume(mesh, t);
-  if (std::memcmp(&ref, &v, sizeof v) != 0) std::abort();
-#endif
-  return v;
-}
-// v[0, mid) and v[mid, end), each sorted, into one sorted list without repeats.
-void mergeSortedRuns(std::vector<std::int32_t>& v, size_t mid, std::vector<std::int32_t>& scratch);
 
 }  // namespace hysim::cutting::opt3d

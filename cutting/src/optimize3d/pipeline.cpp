@@ -48,6 +48,7 @@ CutOptimizer::CutOptimizer(TetMesh& mesh_, const CutRegion& region_, const Optim
   // edge, all together within move_volume_budget of the mesh's volume.
   moveBudget = VolumeBudget{meshVolume * options.move_volume_budget, churnFactor};
   refVolume = curved && options.collapse_volume_fraction_of_edge_tet ? edgeTet : 0.0;
+  if (options.keep_volume && region.volume_target.empty()) volumesNow(startVolumes, &MaterialVolume::before);
   matVol.reserve(8);
   lastBelow.assign(N, -1);
   cons.localId.assign(N, -1);
@@ -76,13 +77,14 @@ void CutOptimizer::run() {
   flips();
   peel();
   finish();
+  keepVolume();
+  if (moved)
+    for (int n = 0; n < N; ++n)
+      if (didMove[n]) moved->push_back(n);
 }
 
 // The nodes moved, then (curved cuts) the flaps peeled and the last-resort collapses.
 void CutOptimizer::finish() {
-  if (moved)
-    for (int n = 0; n < N; ++n)
-      if (didMove[n]) moved->push_back(n);
   if (moved) moved->insert(moved->end(), lateSnapped.begin(), lateSnapped.end());
   if (counts) counts->onto_cut = lateSnapped;
   if (!curved) return;

@@ -177,7 +177,48 @@ bool CutOptimizer::prepareMove(MoveTry& mt, double* before) {
   mt.dirs[0] = 0.25 * h * grad;
   mt.dirs[1] = spring.norm() * unitIn(c, spring);
   mt.dirs[2] = 0.3 * h * push;
+  keepMaterials(mt);
   return true;
+}
+
+// A node between materials moves perpendicular to each material's volume gradient (the sum
+// over its tets of that material): the volume is linear in one node's position, so every
+// material keeps its volume exactly and the interface does not drift. Constraints that put
+// the candidate onto a surface afterwards (Surface, Fan, Ridge) are left to the budgets.
+void CutOptimizer::keepMaterials(MoveTry& mt) {
+  if (mt.c.kind != Freedom::Free && mt.c.kind != Freedom::Plane) return;
+  std::int32_t labels[4];
+  Vec3 grads[4];
+  int numLabels = 0;
+  const int n = mt.n;
+  for (const std::int32_t *s = ed.starBegin(n), *sEnd = ed.starEnd(n); s < sEnd; ++s) {
+    if (dead[*s]) continue;
+    const std::int32_t label = labelOf(mesh, *s);
+    int i = 0;
+    while (i < numLabels && labels[i] != label) ++i;
+    if (i == numLabels) {
+      if (numLabels == 4) return;
+      labels[numLabels] = label;
+      grads[numLabels++] = Vec3::Zero();
+    }
+    int k = 0;
+    while (mesh.T(*s, k) != n) ++k;
+    grads[i] += tetVolumeGradient(mesh, *s, k);
+  }
+  if (numLabels < 2) return;
+  Vec3 basis[3];
+  int nb = 0;
+  if (mt.c.kind == Freedom::Plane) basis[nb++] = mt.c.normal.normalized();
+  for (int i = 0; i < numLabels && nb < 3; ++i) {
+    Vec3 g = grads[i];
+    const double scale = g.norm();
+    for (int b = 0; b < nb; ++b) g -= g.dot(basis[b]) * basis[b];
+    if (g.norm() > 1e-9 * scale) basis[nb++] = g.normalized();
+  }
+  for (Vec3& d : mt.dirs) {
+    if (nb == 3) d.setZero();
+    for (int b = 0; b < nb && nb < 3; ++b) d -= d.dot(basis[b]) * basis[b];
+  }
 }
 
 // q* of the node's worst tet with the node at y (its corners as gathered: the same values as

@@ -15,16 +15,6 @@
 
 namespace hysim::cutting::opt3d {
 
-// v[0, mid) and v[mid, end), each sorted, into one sorted list without repeats (what sort +
-// unique of the whole gives); scratch is working room.
-void mergeSortedRuns(std::vector<std::int32_t>& v, size_t mid, std::vector<std::int32_t>& scratch) {
-  scratch.clear();
-  const auto m = v.begin() + static_cast<std::ptrdiff_t>(mid);
-  std::merge(v.begin(), m, m, v.end(), std::back_inserter(scratch));
-  scratch.erase(std::unique(scratch.begin(), scratch.end()), scratch.end());
-  v.swap(scratch);
-}
-
 // Per material (collapse_material_limit): matVol gathers, per label, (before, after) of the
 // star's tets (a tet keeps its label, a dying tet's volume goes); matFits checks each against
 // collapse_volume_fraction of its own part or of the whole star (starBefore).
@@ -87,14 +77,14 @@ double optimizeMeshVolume(const TetMesh& mesh) {
       const __m128d v = _mm_div_pd(v6, six);
       const double v0 = _mm_cvtsd_f64(v), v1 = _mm_cvtsd_f64(_mm_unpackhi_pd(v, v));
 #ifdef HYSIM_CHECK_EXACT
-      const double r0 = opt3d::tetVolumeHere(mesh, t), r1 = opt3d::tetVolumeHere(mesh, t + 1);
+      const double r0 = tetVolumeHere(mesh, t), r1 = tetVolumeHere(mesh, t + 1);
       if (std::memcmp(&r0, &v0, sizeof v0) != 0 || std::memcmp(&r1, &v1, sizeof v1) != 0) std::abort();
 #endif
       meshVolume += v0;
       meshVolume += v1;
     }
 #endif
-    for (; t < M; ++t) meshVolume += opt3d::tetVolumeHere(mesh, t);
+    for (; t < M; ++t) meshVolume += tetVolumeHere(mesh, t);
   }
   return meshVolume;
 }

@@ -151,6 +151,18 @@ struct Optimize3DOptions {
   double flap_pass_volume = 8.0;
   int flap_max_tets = 24;
   double flap_grow_factor = 3.0;
+  // Last: each material label's volume is brought back to what the cut's input had (peels,
+  // flaps, collapses and boundary moves lose or gain some), by moving the region's boundary
+  // nodes whose live tets all have that label along their volume gradients: the smallest
+  // moves (least squares) that restore it, each refused where a tet would invert or the worst
+  // q* around the node would fall below min(quality_target, before), so the mesh's worst q*
+  // never falls. Within keep_volume_tolerance of the mesh's volume; a node
+  // moves at most keep_volume_step x the cut's local edge; the nodes that move lie off the cut,
+  // within keep_volume_rings edge steps of the optimised region.
+  bool keep_volume = true;
+  double keep_volume_tolerance = 1e-9;
+  double keep_volume_step = 0.1;
+  int keep_volume_rings = 2;
 };
 
 struct Cut3DOptions {
@@ -238,6 +250,8 @@ struct Cut3DReport {
   int late_snaps = 0;         // nodes near the cut the optimisation moved onto it
   int peeled_elements = 0;    // slivers removed by the optimisation
   double peeled_volume = 0;   // their volume
+  double volume_restored = 0;  // volume the optimisation's last step put back (keep_volume)
+  int volume_moves = 0;        // the boundary node moves that did it
   int flap_peeled = 0;        // of the peeled elements, those removed in flaps (flap_quality)
   int optimize_iterations = 0;
   int cut_off_pieces = 0;     // pieces left out of the optimisation (anchored_nodes)
@@ -284,6 +298,9 @@ double totalVolume(const TetMesh& mesh);
 // Each material label's volume in two meshes (a cut's input and output), ascending by label;
 // a label missing from one mesh has volume 0 there (material_volumes.cpp).
 std::vector<MaterialVolume> materialVolumes(const TetMesh& before, const TetMesh& after);
+// The same in steps: `before` of one mesh, then `after` of another added.
+std::vector<MaterialVolume> materialVolumes(const TetMesh& before);
+void addVolumesAfter(const TetMesh& after, std::vector<MaterialVolume>* volumes);
 
 // Largest signed distance by which a tet has nodes strictly on both sides of a plane, as a
 // check: returns the number of tets with a node > eps and a node < -eps.

@@ -132,6 +132,8 @@ class TetMeshEditor {
   // Moves n to y unless a tet around it would invert or its worst q* would fall below
   // min(floor, the worst before). Returns whether it moved.
   bool moveNode(int n, const Vec3& y, double floor);
+  // moveNode's check alone (a caller that moves with setPosition and records nothing).
+  bool moveAllowed(int n, const Vec3& y, double floor);
   // A copy of n at its position taking n's place in `tets` (tets around n): the two sides
   // of a cut separate there. Returns the copy, or -1 when a tet of `tets` does not hold n.
   int duplicateNode(int n, const std::vector<std::int32_t>& tets);
@@ -191,6 +193,9 @@ class TetMeshEditor {
     double q;
     std::int8_t up;  // positively oriented at these positions (1, 0), -1: not asked yet
   };
+  QEntry keyOf(int t) const;                    // t's nodes and their versions
+  QEntry* cached(int t, const QEntry& key);      // t's entry where computed at key, else null
+  double store(int t, QEntry key, std::int8_t up);  // computes q* at key, caches it
   std::vector<std::int32_t> qSlot_;  // per tet: its entry in qPool_, -1 none
   std::vector<QEntry, NoInitAllocator<QEntry>> qPool_;
   std::int32_t qNext_ = 0;
