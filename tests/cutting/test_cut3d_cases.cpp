@@ -6,22 +6,13 @@
 #include <array>
 #include <cmath>
 
+#include "box_mesh.hpp"
 #include "hysim/cutting/cut3d.hpp"
 
 namespace hysim::cutting {
 namespace {
 
 using Vec3 = Eigen::Vector3d;
-
-TetMesh unitCornerTet() {
-  TetMesh m;
-  m.X.resize(4, 3);
-  m.X << 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1;
-  m.T.resize(1, 4);
-  m.T << 0, 1, 2, 3;
-  m.material = Labels::Zero(1);
-  return m;
-}
 
 struct Expected {
   TetCutCase tetCase;
@@ -33,7 +24,7 @@ struct Expected {
 Cut3DResult cutCase(const Vec3& point, const Vec3& normal, const Expected& want) {
   Cut3DOptions options;
   options.optimize.enabled = false;
-  const TetMesh tet = unitCornerTet();
+  const TetMesh tet = testing::singleTet();
   auto plane = CutSurface::plane(point, normal);
   EXPECT_TRUE(plane.ok());
   auto r = cut3d(tet, *plane, options);

@@ -1,6 +1,6 @@
 #pragma once
 // Keys, small hash maps and the tet's local numbering shared by the stages of a 3D cut.
-#include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <array>
 #include <cstdint>
 #include <utility>

@@ -35,6 +35,22 @@ bool evenFacePairs(const Work& w, int n, const std::vector<std::int32_t>& starOf
   return acc == 0;
 }
 
+// Whether f(p, q) holds for every tet of n's star: its corners now (p) and with n at
+// `target` (q).
+template <class F>
+bool everyMovedTet(const Work& w, const StarLists& stars, int n, const Vec3& target, F&& f) {
+  for (int s = stars.off[n]; s < stars.off[n + 1]; ++s) {
+    const Tet& tv = w.tet(stars.star[s]);
+    Vec3 p[4], q[4];
+    for (int k = 0; k < 4; ++k) {
+      p[k] = w.x(tv[k]);
+      q[k] = tv[k] == n ? target : p[k];
+    }
+    if (!f(p, q)) return false;
+  }
+  return true;
+}
+
 }  // namespace
 
 // Moving node n to `target` keeps every tet of its star positive, not flat and not badly
@@ -62,32 +78,18 @@ bool Cut3D::guardOk(int n, const Vec3& target) {
 }
 
 bool Cut3D::guardVolumes(int n, const Vec3& target) const {
-  for (int s = stars.off[n]; s < stars.off[n + 1]; ++s) {
-    const Tet& tv = w.tet(stars.star[s]);
-    Vec3 p[4], q[4];
-    for (int k = 0; k < 4; ++k) {
-      p[k] = w.x(tv[k]);
-      q[k] = tv[k] == n ? target : p[k];
-    }
+  return everyMovedTet(w, stars, n, target, [](const Vec3* p, const Vec3* q) {
     const double v0 = signedVolume(p[0], p[1], p[2], p[3]);
     const double v1 = signedVolume(q[0], q[1], q[2], q[3]);
-    if (!(v1 > 1e-3 * v0)) return false;
-  }
-  return true;
+    return v1 > 1e-3 * v0;
+  });
 }
 
 bool Cut3D::guardQuality(int n, const Vec3& target) const {
-  for (int s = stars.off[n]; s < stars.off[n + 1]; ++s) {
-    const Tet& tv = w.tet(stars.star[s]);
-    Vec3 p[4], q[4];
-    for (int k = 0; k < 4; ++k) {
-      p[k] = w.x(tv[k]);
-      q[k] = tv[k] == n ? target : p[k];
-    }
+  return everyMovedTet(w, stars, n, target, [this](const Vec3* p, const Vec3* q) {
     const double qa = radiusRatio(q[0], q[1], q[2], q[3]);
-    if (qa < options.min_quality && qa < radiusRatio(p[0], p[1], p[2], p[3])) return false;
-  }
-  return true;
+    return !(qa < options.min_quality && qa < radiusRatio(p[0], p[1], p[2], p[3]));
+  });
 }
 
 // The faces go to `out` (cleared first): scratch vectors owned by the callers, so that no
