@@ -1,6 +1,6 @@
 #pragma once
 // Test meshes made by hand: a box of nx*ny*nz cubes, each split into the 6 Kuhn tets around
-// its main diagonal (conforming across cubes, all positively oriented).
+// its main diagonal (conforming across cubes, all positively oriented), and the unit corner tet.
 #include <array>
 #include <utility>
 
@@ -34,6 +34,17 @@ inline cutting::TetMesh boxTetMesh(int nx, int ny, int nz, double h, int label =
           ++t;
         }
   m.material = cutting::Labels::Constant(m.T.rows(), label);
+  return m;
+}
+
+// The tet (0,0,0), (1,0,0), (0,1,0), (0,0,1), material 0.
+inline cutting::TetMesh singleTet() {
+  cutting::TetMesh m;
+  m.X.resize(4, 3);
+  m.X << 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1;
+  m.T.resize(1, 4);
+  m.T << 0, 1, 2, 3;
+  m.material = cutting::Labels::Zero(1);
   return m;
 }
 

@@ -20,15 +20,7 @@ namespace {
 
 using Vec3 = Eigen::Vector3d;
 
-TetMesh singleTet() {
-  TetMesh m;
-  m.X.resize(4, 3);
-  m.X << 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1;
-  m.T.resize(1, 4);
-  m.T << 0, 1, 2, 3;
-  m.material = Labels::Zero(1);
-  return m;
-}
+using testing::singleTet;
 
 Cut3DOptions withMethod(CutMethod method) {
   Cut3DOptions o;

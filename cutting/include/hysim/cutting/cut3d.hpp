@@ -5,7 +5,7 @@
 // optimisation after the cut (beyond the paper), and the baselines with the same interface
 // (standard subdivision, snapping only, element deletion).
 //
-// Outline of one cut (cut3d.cpp):
+// Outline of one cut (cut3d.cpp drives the stages, one file each in src/cut3d/):
 //  1. classify nodes against the surface (tolerance eps, see cut_surface.hpp); find the
 //     crossed edges (end points strictly on opposite sides, crossing inside the surface);
 //  2. hybrid/snap: a node whose crossing lies within snap_region * |e| of it moves onto the
@@ -15,13 +15,15 @@
 //     edge below min_edge_fraction of its length, is refused and the edges stay crossed;
 //  3. every edge still crossed is split at the crossing (conforming edge bisection: each tet
 //     around the edge becomes two), which gives the subdivided configurations (1-3 and 2-2
-//     splits into 4 and 6 tets, partial patterns where the surface ends inside the tet);
+//     splits into 4 and 6 tets, partial patterns where the surface ends inside the tet); a
+//     crossed tet is then one of the paper's four cases (TetCutCase: 0-3 nodes on the cut);
 //  4. node separation: faces lying in the cut and shared by two tets are cut faces; each node
 //     on the cut gets one copy per group of its incident tets connected through non-cut
 //     faces, so every element keeps the copy of its side and a crack tip (partial cut) stays
 //     connected;
 //  5. hybrid: local optimisation (see Optimize3DOptions).
 #include <Eigen/Core>
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <vector>
@@ -222,6 +224,11 @@ struct Cut3DOptions {
   int free_piece_search_limit = 20000;
 };
 
+// The paper's four rotationally invariant cases of a tet the cut passes through: after
+// snapping, zero to three of its nodes lie on the cut and are separated there; the rest of
+// the tet is subdivided (Cut3DReport::tets_by_case).
+enum class TetCutCase : int { NoNodeSeparated = 0, OneNodeSeparated = 1, TwoNodesSeparated = 2, ThreeNodesSeparated = 3 };
+
 // One material label's volume in the input and output mesh of a cut (Cut3DReport).
 struct MaterialVolume {
   std::int32_t label = 0;  // TetMesh::material
@@ -242,6 +249,9 @@ struct Cut3DReport {
   double max_route_deviation_mm = 0;  // largest distance of a routed node from the cut surface
   int split_edges = 0;        // new nodes on edges
   int split_elements = 0;     // original tets subdivided
+  // Crossed tets the cut still passes through after snapping (an edge still crossed, or a
+  // face on the cut), by TetCutCase; not counted for Delete.
+  std::array<int, 4> tets_by_case{};
   int deleted_elements = 0;
   int duplicated_nodes = 0;
   int cut_faces = 0;          // interior faces on the cut (now separated)
