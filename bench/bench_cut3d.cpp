@@ -385,8 +385,9 @@ void BM_Cut3DReplay(benchmark::State& state) {
     return x * x + y * y + z * z > 1;
   };
   if (leaveChips) o.anchored_at = outside;
-  std::vector<double> cutMs, optMs;
-  double qSum = 0, qKept = 0;
+  std::vector<double> cutMs, optMs, keepMs;
+  double qSum = 0, qKept = 0, driftMax = 0;
+  int driftOver = 0;
   int cutOff = 0;
   for (auto _ : state) {
     qSum = 0;
@@ -407,6 +408,10 @@ void BM_Cut3DReplay(benchmark::State& state) {
       }
       cutMs.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
       optMs.push_back(r->report.optimize_ms);
+      keepMs.push_back(r->report.keep_volume_ms);
+      const double drift = std::abs(r->report.volume_drift) / r->report.volume_before;
+      driftMax = std::max(driftMax, drift);
+      if (drift > 1e-5) ++driftOver;
       state.PauseTiming();
       qSum += hysim::cutting::computeStats(r->mesh).q_min;
       {  // q*_min of the anchored pieces (what the simulator keeps)
@@ -433,6 +438,9 @@ void BM_Cut3DReplay(benchmark::State& state) {
   };
   state.counters["cut_ms"] = medianOf(cutMs);
   state.counters["optimize_ms"] = medianOf(optMs);
+  state.counters["keep_volume_ms"] = medianOf(keepMs);
+  state.counters["drift_max"] = driftMax;  // largest |volume drift| / volume of a cut
+  state.counters["drift_over"] = driftOver / static_cast<double>(state.iterations());  // cuts above 1e-5
   state.counters["cut_ms_max"] = cutMs.empty() ? 0.0 : *std::max_element(cutMs.begin(), cutMs.end());
   state.counters["optimize_ms_max"] = optMs.empty() ? 0.0 : *std::max_element(optMs.begin(), optMs.end());
   state.counters["passes"] = static_cast<double>(passes.size());

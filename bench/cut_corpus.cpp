@@ -3,7 +3,7 @@
 // from the input mesh, by random complete planes (through the middle 40% of the bounding box)
 // and by curved patches (spheres and cylinders; complete, or ending inside the mesh), with the
 // default hybrid options. Each cut is checked against the bounds of tests/common/cut_checks.hpp
-// (valid, separated, growth <= 1.10, q*_min >= 0.25x, min edge >= 0.2x, |dV|/V <= 1e-3).
+// (valid, separated, growth <= 1.10, q*_min >= 0.25x, min edge >= 0.2x, |dV|/V <= 1e-5).
 // Prints a table per mesh and cut family, then every miss with its reasons and a command that
 // repeats it (a plane at full precision, or the surface written to --dump).
 // Exit status: 0 every cut valid and separated and >= 99% within all bounds, 2 otherwise,

@@ -90,7 +90,7 @@ struct OptimizeCounts {
   double peeled_volume = 0;
   double volume_restored = 0;  // keep_volume: the volume put back (net, all labels)
   int volume_moves = 0;
-  double collapse_ms = 0, late_snap_ms = 0, move_ms = 0;  // wall time of those steps
+  double collapse_ms = 0, late_snap_ms = 0, move_ms = 0, keep_volume_ms = 0;  // wall time of those steps
 };
 
 // See Optimize3DOptions. Appends the nodes it moved to *moved; *dead (#T) marks the slivers

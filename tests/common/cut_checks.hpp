@@ -21,7 +21,7 @@ struct CutBounds {
   double growth = 1.10;
   double q_ratio = 0.25;
   double edge_ratio = 0.2;
-  double volume = 1e-3;  // |V_out - V_in| / V_in
+  double volume = 1e-5;  // |V_out - V_in| / V_in
 };
 
 // What the bounds are measured against.

@@ -126,6 +126,7 @@ class Cut3D {
   void compact();
 
   Cut3DResult result;
+  std::vector<MaterialVolume> inputVolumes;  // per label, where the optimisation asked for them
 
  private:
   // classify.cpp

@@ -25,6 +25,8 @@ void Cut3D::runOptimisation() {
   checkPatchedStars();
 #endif
   region.stars = &stars;
+  inputVolumes = materialVolumes(input);
+  region.volume_target = inputVolumes;
   // The pieces cut off (options.anchored_nodes) are left as they are: no seeds there, and
   // their tets are dead to the optimisation (unmarked in `peeled` after it).
   std::vector<std::uint8_t> cutOffTets, cutOffNodes;
@@ -106,10 +108,13 @@ void Cut3D::reportOptimisation(const OptimizeCounts& counts, size_t movedBefore)
   std::sort(cutNodes.begin() + mid, cutNodes.end());
   std::inplace_merge(cutNodes.begin(), cutNodes.begin() + mid, cutNodes.end());
   report.peeled_volume = counts.peeled_volume;
+  report.volume_restored = counts.volume_restored;
+  report.volume_moves = counts.volume_moves;
   report.optimized_nodes = static_cast<int>(moved.size() - movedBefore);
   report.collapse_ms = counts.collapse_ms;
   report.late_snap_ms = counts.late_snap_ms;
   report.move_ms = counts.move_ms;
+  report.keep_volume_ms = counts.keep_volume_ms;
 }
 
 }  // namespace hysim::cutting::cut3d_detail

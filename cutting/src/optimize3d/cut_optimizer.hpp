@@ -221,10 +221,30 @@ class CutOptimizer {
   void keepVolume();
   bool leftAlone(int t) const;
   void volumesNow(std::vector<MaterialVolume>& volumes, double MaterialVolume::*field) const;
-  void volumeMovers(std::int32_t label, int rings, std::vector<std::int32_t>& nodes);
-  Vec3 labelGradient(int n, std::int32_t label) const;
-  double starVolumeOf(int n) const;
-  double volumeSweep(std::int32_t label, double deficit, std::vector<std::int32_t>& movers, std::vector<Vec3>& from);
+  // What keepVolume asks of a move: more volume for `label` (from the boundary, other < 0,
+  // or from the material `other` across their interface), and what the moves changed.
+  struct VolumeGoal {
+    std::int32_t label, other;
+  };
+  struct VolumeChange {
+    double label = 0, other = 0;
+  };
+  // A node near the region as keepVolume sees it (gatherVolumeNodes).
+  struct VolumeNode {
+    std::int32_t n, a, b;  // the labels around it (b -1: one)
+    std::int8_t ring;      // edge steps from the region's tets
+    bool boundary;         // else inside
+  };
+  void gatherVolumeNodes(int maxRings);
+  bool describeVolumeNode(int n, VolumeNode* info) const;
+  void volumeMovers(const VolumeGoal& goal, int rings, std::vector<std::int32_t>& nodes);
+  Vec3 goalGradient(int n, const VolumeGoal& goal) const;
+  double starVolumeOf(int n, std::int32_t label) const;
+  void volumeSweep(const VolumeGoal& goal, double amount, std::vector<std::int32_t>& movers, std::vector<Vec3>& from,
+                   VolumeChange* change);
+  VolumeChange restoreVolume(const VolumeGoal& goal, double amount, double tolerance);
+  void exchangeVolume(MaterialVolume& a, MaterialVolume& b, double amount, double tolerance);
+  void boundaryVolume(MaterialVolume& m, double tolerance);
   // flips.cpp
   void flips();
   void flipCandidates(int round, std::vector<std::int32_t>& cands);
@@ -298,6 +318,9 @@ class CutOptimizer {
   VolumeBudget budget, moveBudget;
   std::vector<MatVol> matVol;
   std::vector<MaterialVolume> startVolumes;  // keep_volume without region.volume_target
+  std::vector<VolumeNode> volumeNodes;       // keep_volume.cpp: gathered within gatheredRings
+  int gatheredRings = -1;
+  double volumeFloor = 1.0;  // the region's worst q* when keepVolume starts
 
   // Seeds and region (region.cpp).
   std::vector<std::int32_t> seeds, lateSnapped, around;

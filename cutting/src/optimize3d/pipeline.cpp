@@ -77,7 +77,7 @@ void CutOptimizer::run() {
   flips();
   peel();
   finish();
-  keepVolume();
+  timed(&OptimizeCounts::keep_volume_ms, [this] { keepVolume(); });
   if (moved)
     for (int n = 0; n < N; ++n)
       if (didMove[n]) moved->push_back(n);

@@ -157,12 +157,13 @@ struct Optimize3DOptions {
   // flaps, collapses and boundary moves lose or gain some), by moving the region's boundary
   // nodes whose live tets all have that label along their volume gradients: the smallest
   // moves (least squares) that restore it, each refused where a tet would invert or the worst
-  // q* around the node would fall below min(quality_target, before), so the mesh's worst q*
-  // never falls. Within keep_volume_tolerance of the mesh's volume; a node
-  // moves at most keep_volume_step x the cut's local edge; the nodes that move lie off the cut,
-  // within keep_volume_rings edge steps of the optimised region.
+  // q* around the node would fall below min(before, the region's worst q*), so the mesh's
+  // worst q* does not fall. What one material gained from another goes back across
+  // their interface first. Within keep_volume_tolerance of the mesh's volume; a node moves at
+  // most keep_volume_step x the cut's local edge; the nodes that move lie off the cut, within
+  // keep_volume_rings (then twice that) edge steps of the optimised region.
   bool keep_volume = true;
-  double keep_volume_tolerance = 1e-9;
+  double keep_volume_tolerance = 1e-7;
   double keep_volume_step = 0.1;
   int keep_volume_rings = 2;
 };
@@ -276,10 +277,10 @@ struct Cut3DReport {
   // Wall time of the steps (ms), for profiling: classification (with the node -> tets lists
   // and the work arrays), snapping (with moving away and routing), subdivision, separation,
   // assembly (the output arrays, the node -> tets lists patched, the pieces cut off), the
-  // compaction after the optimisation; and of the optimisation's edge collapses, late snaps
-  // and move loop (parts of optimize_ms).
+  // compaction after the optimisation; and of the optimisation's edge collapses, late snaps,
+  // move loop and volume kept (parts of optimize_ms).
   double classify_ms = 0, snap_ms = 0, subdivide_ms = 0, separate_ms = 0, assemble_ms = 0, compact_ms = 0;
-  double collapse_ms = 0, late_snap_ms = 0, move_ms = 0;
+  double collapse_ms = 0, late_snap_ms = 0, move_ms = 0, keep_volume_ms = 0;
 };
 
 struct Cut3DResult {
