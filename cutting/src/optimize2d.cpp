@@ -143,8 +143,17 @@ void distributeOnCut(Work& w, const std::vector<int>& ch, double minQuality) {
   }
 }
 
-void regularise(Work& w, const Chains& chains, double meanEdge, const Cut2DOptions& o, Cut2DReport& rep) {
-  const auto& oo = o.optimize;
+// The nodes regularise moves, with the tangent a border node slides along (zero inside),
+// their neighbour lists (CSR) and the mean local edge length.
+struct Springs {
+  std::vector<int> movable;
+  std::vector<Vec2> tangent;
+  std::vector<int> start{0}, adj;
+  double L0 = 0;
+};
+
+// The nodes one to `rings` edge steps from the cut chains, ring by ring.
+std::vector<int> nodesNearCut(const Work& w, const Chains& chains, int rings) {
   const int N = static_cast<int>(w.nodes.size());
   std::vector<int> ring(N, -1);
   std::vector<int> frontier, next, nb;
@@ -155,7 +164,7 @@ void regularise(Work& w, const Chains& chains, double meanEdge, const Cut2DOptio
         frontier.push_back(n);
       }
   std::vector<int> movable;
-  for (int r = 1; r <= oo.rings; ++r) {
+  for (int r = 1; r <= rings; ++r) {
     next.clear();
     for (int n : frontier) {
       w.neighbours(n, nb);
@@ -168,97 +177,119 @@ void regularise(Work& w, const Chains& chains, double meanEdge, const Cut2DOptio
     }
     frontier.swap(next);
   }
-  // Border nodes slide along the border where it is straight (their two border edges
-  // collinear); elsewhere on the border (curves, corners) they stay.
-  std::vector<Vec2> tangent;
-  {
-    std::vector<int> keep;
-    for (int n : movable) {
-      if (!w.isBorderNode(n)) {
-        keep.push_back(n);
-        tangent.push_back(Vec2::Zero());
-        continue;
-      }
-      w.neighbours(n, nb);
-      std::vector<int> bn;
-      for (int x : nb)
-        if (w.isBorderEdge(n, x)) bn.push_back(x);
-      if (bn.size() != 2) continue;
-      const Vec2 d0 = w.nodes[n].p - w.nodes[bn[0]].p, d1 = w.nodes[bn[1]].p - w.nodes[n].p;
-      if (std::abs(cross2(d0, d1)) > 1e-12 * d0.norm() * d1.norm() || d0.dot(d1) <= 0) continue;
+  return movable;
+}
+
+// Border nodes slide along the border where it is straight (their two border edges
+// collinear); elsewhere on the border (curves, corners) they stay.
+void keepMovable(const Work& w, Springs& s) {
+  std::vector<int> keep, nb;
+  for (int n : s.movable) {
+    if (!w.isBorderNode(n)) {
       keep.push_back(n);
-      tangent.push_back(d0.normalized());
+      s.tangent.push_back(Vec2::Zero());
+      continue;
     }
-    movable.swap(keep);
+    w.neighbours(n, nb);
+    std::vector<int> bn;
+    for (int x : nb)
+      if (w.isBorderEdge(n, x)) bn.push_back(x);
+    if (bn.size() != 2) continue;
+    const Vec2 d0 = w.nodes[n].p - w.nodes[bn[0]].p, d1 = w.nodes[bn[1]].p - w.nodes[n].p;
+    if (std::abs(cross2(d0, d1)) > 1e-12 * d0.norm() * d1.norm() || d0.dot(d1) <= 0) continue;
+    keep.push_back(n);
+    s.tangent.push_back(d0.normalized());
   }
-  rep.regularised_nodes = static_cast<int>(movable.size());
-  if (movable.empty()) return;
-  // Compact neighbour lists (CSR) and the mean local edge length.
-  std::vector<int> start{0}, adj;
-  double L0 = 0;
+  s.movable.swap(keep);
+}
+
+// Compact neighbour lists (CSR) and the mean local edge length.
+void buildNeighbourLists(const Work& w, Springs& s) {
+  std::vector<int> nb;
   int ne = 0;
-  for (int n : movable) {
+  for (int n : s.movable) {
     w.neighbours(n, nb);
     for (int x : nb) {
-      adj.push_back(x);
-      L0 += (w.nodes[x].p - w.nodes[n].p).norm();
+      s.adj.push_back(x);
+      s.L0 += (w.nodes[x].p - w.nodes[n].p).norm();
       ++ne;
     }
-    start.push_back(static_cast<int>(adj.size()));
+    s.start.push_back(static_cast<int>(s.adj.size()));
   }
-  L0 /= std::max(ne, 1);
-  const double stop = oo.stop_fraction * meanEdge;
-  const double minArea2 = 1e-3 * L0 * L0;  // never flatten: twice the area stays above this
-  const int M = static_cast<int>(movable.size());
-  std::vector<Vec2> vel(M, Vec2::Zero()), force(M);
+  s.L0 /= std::max(ne, 1);
+}
+
+void springForces(const Work& w, const Springs& s, const Optimize2DOptions& oo, std::vector<Vec2>& force) {
+  const double L0 = s.L0;
+  for (size_t i = 0; i < s.movable.size(); ++i) {
+    const Vec2 xi = w.nodes[s.movable[i]].p;
+    Vec2 f = Vec2::Zero();
+    for (int k = s.start[i]; k < s.start[i + 1]; ++k) {
+      const Vec2 d = w.nodes[s.adj[k]].p - xi;
+      const double r = d.norm();
+      if (r <= 1e-12 * L0) continue;
+      // Spring towards the rest length L0 (alpha), particle repulsion inside L0 (beta):
+      // magnitude L0^2/r - r, unbounded as r -> 0, capped at L0 for stability.
+      double mag = oo.spring_weight * (r - L0);
+      if (r < L0) mag -= oo.particle_weight * std::min(L0 * L0 / r - r, L0);
+      f += (mag / r) * d;
+    }
+    force[i] = f;
+  }
+}
+
+// One damped step of every movable node; returns the largest move taken.
+double moveNodes(Work& w, const Springs& s, const Optimize2DOptions& oo, const std::vector<Vec2>& force,
+                 std::vector<Vec2>& vel) {
+  const double minArea2 = 1e-3 * s.L0 * s.L0;  // never flatten: twice the area stays above this
   const double damping = 0.1;  // fraction of velocity kept per step (heavy damping)
+  double maxMove = 0;
+  for (size_t i = 0; i < s.movable.size(); ++i) {
+    const int n = s.movable[i];
+    vel[i] = damping * vel[i] + oo.step_gain * force[i];
+    if (s.tangent[i].x() != 0 || s.tangent[i].y() != 0) vel[i] = vel[i].dot(s.tangent[i]) * s.tangent[i];
+    const Vec2 p = w.nodes[n].p + vel[i];
+    // Never fold or flatten an element, and never push the worst element around the node
+    // below min(its current quality, quality_guard).
+    bool ok = true;
+    double qBefore = 1.0, qAfter = 1.0;
+    for (int t : w.nodeTris[n]) {
+      const auto& v = w.tris[t].v;
+      Vec2 c[3];
+      for (int k = 0; k < 3; ++k) c[k] = v[k] == n ? p : w.nodes[v[k]].p;
+      if (orient(c[0], c[1], c[2]) <= minArea2) {
+        ok = false;
+        break;
+      }
+      qAfter = std::min(qAfter, triQuality(c[0], c[1], c[2]));
+      qBefore = std::min(qBefore, triQuality(w.nodes[v[0]].p, w.nodes[v[1]].p, w.nodes[v[2]].p));
+    }
+    if (ok && qAfter < std::min(qBefore, oo.quality_guard)) ok = false;
+    if (!ok) {
+      vel[i].setZero();
+      continue;
+    }
+    maxMove = std::max(maxMove, vel[i].norm());
+    w.nodes[n].p = p;
+  }
+  return maxMove;
+}
+
+void regularise(Work& w, const Chains& chains, double meanEdge, const Cut2DOptions& o, Cut2DReport& rep) {
+  const auto& oo = o.optimize;
+  Springs s;
+  s.movable = nodesNearCut(w, chains, oo.rings);
+  keepMovable(w, s);
+  rep.regularised_nodes = static_cast<int>(s.movable.size());
+  if (s.movable.empty()) return;
+  buildNeighbourLists(w, s);
+  const double stop = oo.stop_fraction * meanEdge;
+  const int M = static_cast<int>(s.movable.size());
+  std::vector<Vec2> vel(M, Vec2::Zero()), force(M);
   int it = 0;
   for (; it < oo.max_iterations; ++it) {
-    for (int i = 0; i < M; ++i) {
-      const Vec2 xi = w.nodes[movable[i]].p;
-      Vec2 f = Vec2::Zero();
-      for (int k = start[i]; k < start[i + 1]; ++k) {
-        const Vec2 d = w.nodes[adj[k]].p - xi;
-        const double r = d.norm();
-        if (r <= 1e-12 * L0) continue;
-        // Spring towards the rest length L0 (alpha), particle repulsion inside L0 (beta):
-        // magnitude L0^2/r - r, unbounded as r -> 0, capped at L0 for stability.
-        double mag = oo.spring_weight * (r - L0);
-        if (r < L0) mag -= oo.particle_weight * std::min(L0 * L0 / r - r, L0);
-        f += (mag / r) * d;
-      }
-      force[i] = f;
-    }
-    double maxMove = 0;
-    for (int i = 0; i < M; ++i) {
-      const int n = movable[i];
-      vel[i] = damping * vel[i] + oo.step_gain * force[i];
-      if (tangent[i].x() != 0 || tangent[i].y() != 0) vel[i] = vel[i].dot(tangent[i]) * tangent[i];
-      const Vec2 p = w.nodes[n].p + vel[i];
-      // Never fold or flatten an element, and never push the worst element around the node
-      // below min(its current quality, quality_guard).
-      bool ok = true;
-      double qBefore = 1.0, qAfter = 1.0;
-      for (int t : w.nodeTris[n]) {
-        const auto& v = w.tris[t].v;
-        Vec2 c[3];
-        for (int k = 0; k < 3; ++k) c[k] = v[k] == n ? p : w.nodes[v[k]].p;
-        if (orient(c[0], c[1], c[2]) <= minArea2) {
-          ok = false;
-          break;
-        }
-        qAfter = std::min(qAfter, triQuality(c[0], c[1], c[2]));
-        qBefore = std::min(qBefore, triQuality(w.nodes[v[0]].p, w.nodes[v[1]].p, w.nodes[v[2]].p));
-      }
-      if (ok && qAfter < std::min(qBefore, oo.quality_guard)) ok = false;
-      if (!ok) {
-        vel[i].setZero();
-        continue;
-      }
-      maxMove = std::max(maxMove, vel[i].norm());
-      w.nodes[n].p = p;
-    }
-    if (maxMove < stop) {
+    springForces(w, s, oo, force);
+    if (moveNodes(w, s, oo, force, vel) < stop) {
       ++it;
       break;
     }
