@@ -59,6 +59,25 @@ int findRoot(std::vector<int>& parent, int a) {
   return a;
 }
 
+// Walks a star's link edges (a, b, index of the tet), sorted: two equal ones join their tets'
+// pieces (union-find over `piece`), a single one is a boundary edge of the link (appended to
+// `boundary`). False where an edge has more than two tets.
+bool joinLinkEdges(const std::vector<std::array<std::int32_t, 3>>& pairs, std::vector<int>& piece,
+                   std::vector<std::array<std::int32_t, 2>>& boundary) {
+  for (size_t i = 0; i < pairs.size();) {
+    size_t j = i;
+    while (j < pairs.size() && pairs[j][0] == pairs[i][0] && pairs[j][1] == pairs[i][1]) ++j;
+    if (j - i > 2) return false;
+    if (j - i == 2) {
+      piece[findRoot(piece, pairs[i][2])] = findRoot(piece, pairs[i + 1][2]);
+    } else {
+      boundary.push_back({pairs[i][0], pairs[i][1]});
+    }
+    i = j;
+  }
+  return true;
+}
+
 }  // namespace
 
 StarShape starShape(const TetMesh& mesh, int v, const std::vector<std::int32_t>& around) {
@@ -87,18 +106,10 @@ StarShape starShape(const TetMesh& mesh, int v, const std::vector<std::int32_t>&
   std::iota(piece.begin(), piece.end(), 0);
   std::vector<std::int32_t> ends;                  // boundary edges' end points, twice each
   std::vector<std::array<std::int32_t, 2>> edges;  // boundary edges of the link
-  for (size_t i = 0; i < pairs.size();) {
-    size_t j = i;
-    while (j < pairs.size() && pairs[j][0] == pairs[i][0] && pairs[j][1] == pairs[i][1]) ++j;
-    if (j - i > 2) return shape;
-    if (j - i == 2) {
-      piece[findRoot(piece, pairs[i][2])] = findRoot(piece, pairs[i + 1][2]);
-    } else {
-      edges.push_back({pairs[i][0], pairs[i][1]});
-      ends.push_back(pairs[i][0]);
-      ends.push_back(pairs[i][1]);
-    }
-    i = j;
+  if (!joinLinkEdges(pairs, piece, edges)) return shape;
+  for (const auto& e : edges) {
+    ends.push_back(e[0]);
+    ends.push_back(e[1]);
   }
   for (int i = 0; i < S; ++i) shape.pieces += findRoot(piece, i) == i;
   std::sort(ends.begin(), ends.end());
@@ -350,19 +361,12 @@ int FlapPeeler::pieces(int v) {
   std::iota(p.begin(), p.end(), 0);
   linkNodes.clear();
   std::vector<std::array<std::int32_t, 2>> boundary;
-  for (size_t i = 0; i < pairs.size();) {
-    size_t j = i;
-    while (j < pairs.size() && pairs[j][0] == pairs[i][0] && pairs[j][1] == pairs[i][1]) ++j;
-    if (j - i > 2) return -1;
-    if (j - i == 2) {
-      p[findRoot(p, pairs[i][2])] = findRoot(p, pairs[i + 1][2]);
-    } else {
-      boundary.push_back({pairs[i][0], pairs[i][1]});
-      linkNodes.push_back(pairs[i][0]);
-      linkNodes.push_back(pairs[i][1]);
-    }
-    i = j;
+  const bool paired = joinLinkEdges(pairs, p, boundary);
+  for (const auto& e : boundary) {
+    linkNodes.push_back(e[0]);
+    linkNodes.push_back(e[1]);
   }
+  if (!paired) return -1;
   int count = 0;
   for (int i = 0; i < S; ++i)
     if (findRoot(p, i) == i) ++count;
