@@ -44,12 +44,13 @@
 #include <vector>
 
 #include "hysim/cutting/mesh_stats.hpp"
+#include "hysim/cutting/tet_faces.hpp"
 
 namespace hysim::cutting {
 namespace {
 
 using Vec3 = Eigen::Vector3d;
-constexpr int kFace[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
+constexpr const auto& kFace = kTetFace;
 
 int findRoot(std::vector<int>& parent, int a) {
   while (parent[a] != a) {

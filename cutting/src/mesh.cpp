@@ -1,8 +1,8 @@
 // Mesh validation, element sizes and tet-mesh boundary extraction.
 //
-// Manifoldness is checked by sorting face (edge) keys rather than hashing: sorting is
-// O(n log n), allocation-light and deterministic, and validate() runs after every cut in
-// tests on 20k-tet meshes.
+// Manifoldness is checked on matched faces (tet_faces.hpp) and sorted edge keys rather than
+// hashing: allocation-light and deterministic, and validate() runs after every cut in tests on
+// 20k-tet meshes.
 #include "hysim/cutting/mesh.hpp"
 
 #include <Eigen/Geometry>
@@ -13,99 +13,11 @@
 #include <string>
 #include <vector>
 
+#include "hysim/cutting/tet_faces.hpp"
+
 namespace hysim::cutting {
 
 namespace {
-
-// The four faces of tet (v0, v1, v2, v3) as local vertex indices, ordered so that each
-// face's normal (right-hand rule) points away from the opposite vertex when the tet is
-// positively oriented. Face k is the one opposite local vertex k.
-constexpr std::array<std::array<int, 3>, 4> kTetFaces = {{
-    {1, 2, 3},  // opposite 0
-    {0, 3, 2},  // opposite 1
-    {0, 1, 3},  // opposite 2
-    {0, 2, 1},  // opposite 3
-}};
-
-// A tet face identified by its sorted node ids, plus where it came from. `even` records
-// whether the face's oriented node order is an even permutation of the sorted order: two
-// correctly oriented tets sharing a face see it with opposite parity.
-struct FaceKey {
-  std::array<std::int32_t, 3> sorted;
-  std::int32_t slot;  // 4 * tet + local face (index into kTetFaces)
-  bool even;
-  std::int32_t tet() const { return slot / 4; }
-};
-
-inline bool sameFace(const FaceKey& a, const FaceKey& b) {
-  return a.sorted[0] == b.sorted[0] && a.sorted[1] == b.sorted[1] && a.sorted[2] == b.sorted[2];
-}
-
-// Sorts three ids and reports whether the sorting permutation is even.
-inline bool sortThreeWithParity(std::array<std::int32_t, 3>& v) {
-  bool even = true;
-  if (v[0] > v[1]) {
-    std::swap(v[0], v[1]);
-    even = !even;
-  }
-  if (v[1] > v[2]) {
-    std::swap(v[1], v[2]);
-    even = !even;
-  }
-  if (v[0] > v[1]) {
-    std::swap(v[0], v[1]);
-    even = !even;
-  }
-  return even;
-}
-
-// Collects the 4*#T face keys sorted by (sorted ids, slot); ties broken by slot so that the
-// order, and hence error messages, are deterministic.
-//
-// Sorting is by buckets: a counting sort on the smallest id, then a small sort inside each
-// bucket (a node's faces, a few dozen). That is O(n) plus tiny sorts and several times faster
-// than one std::sort over all faces. Ids that are negative or far beyond the number of faces
-// (only in invalid meshes) fall back to std::sort, so no huge bucket array is allocated.
-std::vector<FaceKey> sortedTetFaceKeys(const Tets& T) {
-  std::vector<FaceKey> keys;
-  keys.reserve(static_cast<std::size_t>(T.rows()) * 4);
-  std::int32_t minId = 0, maxId = 0;
-  for (Eigen::Index t = 0; t < T.rows(); ++t) {
-    for (int k = 0; k < 4; ++k) {
-      FaceKey key;
-      key.sorted = {T(t, kTetFaces[k][0]), T(t, kTetFaces[k][1]), T(t, kTetFaces[k][2])};
-      key.even = sortThreeWithParity(key.sorted);
-      key.slot = static_cast<std::int32_t>(4 * t + k);
-      minId = std::min(minId, key.sorted[0]);
-      maxId = std::max(maxId, key.sorted[2]);
-      keys.push_back(key);
-    }
-  }
-  // Spelled out: std::array's operators go through memcmp / lexicographical_compare.
-  const auto bySortedThenSlot = [](const FaceKey& a, const FaceKey& b) {
-    if (a.sorted[0] != b.sorted[0]) return a.sorted[0] < b.sorted[0];
-    if (a.sorted[1] != b.sorted[1]) return a.sorted[1] < b.sorted[1];
-    if (a.sorted[2] != b.sorted[2]) return a.sorted[2] < b.sorted[2];
-    return a.slot < b.slot;
-  };
-  const bool bucketable = minId >= 0 && static_cast<std::size_t>(maxId) <= 8 * keys.size() + 1024;
-  if (!bucketable) {
-    std::sort(keys.begin(), keys.end(), bySortedThenSlot);
-    return keys;
-  }
-  // Counting sort by the smallest id; bucketStart has #ids + 1 entries.
-  std::vector<std::int32_t> bucketStart(static_cast<std::size_t>(maxId) + 2, 0);
-  for (const FaceKey& key : keys) ++bucketStart[static_cast<std::size_t>(key.sorted[0]) + 1];
-  for (std::size_t i = 1; i < bucketStart.size(); ++i) bucketStart[i] += bucketStart[i - 1];
-  std::vector<FaceKey> bucketed(keys.size());
-  std::vector<std::int32_t> fill(bucketStart.begin(), bucketStart.end() - 1);
-  for (const FaceKey& key : keys)
-    bucketed[static_cast<std::size_t>(fill[static_cast<std::size_t>(key.sorted[0])]++)] = key;
-  for (std::size_t b = 0; b + 1 < bucketStart.size(); ++b) {
-    std::sort(bucketed.begin() + bucketStart[b], bucketed.begin() + bucketStart[b + 1], bySortedThenSlot);
-  }
-  return bucketed;
-}
 
 std::string formatDouble(double v) {
   char buf[32];
@@ -221,6 +133,60 @@ double triArea(const TriMesh& mesh, int f) {
   return planar ? signedTriAreaXY(mesh.X, mesh.F, f) : unsignedTriArea(mesh.X, mesh.F, f);
 }
 
+namespace {
+
+// Sorts three ids and reports whether the sorting permutation is even: two correctly
+// oriented tets sharing a face see it with opposite parity.
+inline bool sortThreeWithParity(std::array<std::int32_t, 3>& v) {
+  bool even = true;
+  if (v[0] > v[1]) {
+    std::swap(v[0], v[1]);
+    even = !even;
+  }
+  if (v[1] > v[2]) {
+    std::swap(v[1], v[2]);
+    even = !even;
+  }
+  if (v[0] > v[1]) {
+    std::swap(v[0], v[1]);
+    even = !even;
+  }
+  return even;
+}
+
+// Face `slot` (4 t + k) of a tet as sorted node ids; returns the parity of its orientation.
+bool sortedFace(const Tets& T, int slot, std::array<std::int32_t, 3>& sorted) {
+  const int t = slot / 4;
+  const int* local = kTetFace[slot % 4];
+  sorted = {T(t, local[0]), T(t, local[1]), T(t, local[2])};
+  return sortThreeWithParity(sorted);
+}
+
+// Every face of at most two tets, of opposite orientation (indices already checked).
+Status validateFaces(const TetMesh& mesh) {
+  std::vector<int> next;
+  matchFaces(mesh, next);
+  for (int s = 0; s < static_cast<int>(next.size()); ++s) {
+    const int p = next[s];
+    if (p <= s) continue;  // boundary, or the last slot of its face's cycle
+    std::array<std::int32_t, 3> face{}, other{};
+    const bool even = sortedFace(mesh.T, s, face);
+    if (next[p] != s) {
+      return makeError("tet " + std::to_string(next[p] / 4) + ": face " + faceText(face) +
+                       " is shared by more than 2 tets (" + std::to_string(s / 4) + ", " + std::to_string(p / 4) +
+                       ", " + std::to_string(next[p] / 4) + "): non-manifold");
+    }
+    if (sortedFace(mesh.T, p, other) == even) {
+      return makeError("tet " + std::to_string(p / 4) + ": face " + faceText(face) + " shared with tet " +
+                       std::to_string(s / 4) +
+                       " with the same orientation (inconsistent orientation or duplicate tet)");
+    }
+  }
+  return Status::Ok();
+}
+
+}  // namespace
+
 Status validate(const TetMesh& mesh, const ValidateOptions& options) {
   const Eigen::Index numNodes = mesh.X.rows();
   const Eigen::Index numTets = mesh.T.rows();
@@ -240,23 +206,7 @@ Status validate(const TetMesh& mesh, const ValidateOptions& options) {
     }
   }
 
-  const std::vector<FaceKey> keys = sortedTetFaceKeys(mesh.T);
-  for (std::size_t i = 0; i < keys.size();) {
-    std::size_t j = i + 1;
-    while (j < keys.size() && sameFace(keys[j], keys[i])) ++j;
-    if (j - i > 2) {
-      return makeError("tet " + std::to_string(keys[i + 2].tet()) + ": face " + faceText(keys[i].sorted) +
-                       " is shared by more than 2 tets (" + std::to_string(keys[i].tet()) + ", " +
-                       std::to_string(keys[i + 1].tet()) + ", " + std::to_string(keys[i + 2].tet()) +
-                       "): non-manifold");
-    }
-    if (j - i == 2 && keys[i].even == keys[i + 1].even) {
-      return makeError("tet " + std::to_string(keys[i + 1].tet()) + ": face " + faceText(keys[i].sorted) +
-                       " shared with tet " + std::to_string(keys[i].tet()) +
-                       " with the same orientation (inconsistent orientation or duplicate tet)");
-    }
-    i = j;
-  }
+  if (Status s = validateFaces(mesh); !s) return s;
 
   if (options.requireAllNodesUsed) {
     if (Status s = validateAllNodesUsed(numNodes, used); !s) return s;
@@ -330,28 +280,15 @@ Status validate(const TriMesh& mesh, const ValidateOptions& options) {
 }
 
 Tris boundaryFaces(const TetMesh& mesh, Eigen::VectorXi* faceTet) {
-  const std::vector<FaceKey> keys = sortedTetFaceKeys(mesh.T);
-  // Flag boundary faces by (tet, local face) so the output comes in tet order, which is
-  // stable under unrelated edits elsewhere in the mesh.
-  std::vector<char> isBoundary(keys.size(), 0);
-  for (std::size_t i = 0; i < keys.size();) {
-    std::size_t j = i + 1;
-    while (j < keys.size() && sameFace(keys[j], keys[i])) ++j;
-    if (j - i == 1) isBoundary[static_cast<std::size_t>(keys[i].slot)] = 1;
-    i = j;
-  }
-  const Eigen::Index count = std::count(isBoundary.begin(), isBoundary.end(), 1);
-  Tris faces(count, 3);
-  if (faceTet) faceTet->resize(count);
-  Eigen::Index row = 0;
-  for (std::size_t slot = 0; slot < isBoundary.size(); ++slot) {
-    if (!isBoundary[slot]) continue;
-    const Eigen::Index t = static_cast<Eigen::Index>(slot / 4);
-    const auto& local = kTetFaces[slot % 4];
-    faces.row(row) << mesh.T(t, local[0]), mesh.T(t, local[1]), mesh.T(t, local[2]);
-    if (faceTet) (*faceTet)(row) = static_cast<int>(t);
-    ++row;
-  }
+  // In tet order, which is stable under unrelated edits elsewhere in the mesh.
+  std::vector<int> next;
+  matchFacesOfAnyIds(mesh, next);
+  std::vector<std::uint8_t> boundary(next.size());
+  for (size_t s = 0; s < next.size(); ++s) boundary[s] = next[s] < 0;
+  Tris faces;
+  Eigen::VectorXi faceTetHere;
+  boundaryFromSlots(mesh, boundary, faces, faceTetHere);
+  if (faceTet) *faceTet = std::move(faceTetHere);
   return faces;
 }
 

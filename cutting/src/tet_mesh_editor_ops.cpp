@@ -8,11 +8,12 @@
 
 #include "hysim/cutting/mesh_stats.hpp"
 #include "hysim/cutting/tet_mesh_editor.hpp"
+#include "hysim/cutting/tet_faces.hpp"
 
 namespace hysim::cutting {
 namespace {
 
-constexpr int kFaceOf[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
+constexpr const auto& kFaceOf = kTetFace;
 
 double volume6Of(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c,
                  const Eigen::Vector3d& d) {

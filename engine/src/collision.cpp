@@ -11,6 +11,8 @@
 #include <array>
 #include <vector>
 
+#include "hysim/cutting/tet_faces.hpp"
+
 namespace hysim::engine {
 
 using Bvh = fcl::BVHModel<fcl::AABBd>;
@@ -264,18 +266,20 @@ long TissueCollision::numChunksBuilt() const { return impl_->chunks_built; }
 long TissueCollision::numChunksKept() const { return impl_->chunks_kept; }
 
 cutting::Tris allTetFaces(const cutting::TetMesh& mesh) {
+  // One slot per face (its lowest), as sorted node ids in lexicographic order.
+  std::vector<int> next;
+  cutting::matchFacesOfAnyIds(mesh, next);
   std::vector<std::array<int, 3>> faces;
-  faces.reserve(static_cast<size_t>(mesh.numTets()) * 4);
-  constexpr int kFace[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
-  for (int t = 0; t < mesh.numTets(); ++t) {
-    for (const auto& f : kFace) {
-      std::array<int, 3> key = {mesh.T(t, f[0]), mesh.T(t, f[1]), mesh.T(t, f[2])};
-      std::sort(key.begin(), key.end());
-      faces.push_back(key);
-    }
+  faces.reserve(next.size() / 2 + 1);
+  for (int s = 0; s < static_cast<int>(next.size()); ++s) {
+    if (cutting::firstSlotOfFace(next, s) != s) continue;
+    const int t = s / 4;
+    const int* local = cutting::kTetFace[s % 4];
+    std::array<int, 3> key = {mesh.T(t, local[0]), mesh.T(t, local[1]), mesh.T(t, local[2])};
+    std::sort(key.begin(), key.end());
+    faces.push_back(key);
   }
   std::sort(faces.begin(), faces.end());
-  faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
   cutting::Tris out(static_cast<Eigen::Index>(faces.size()), 3);
   for (size_t f = 0; f < faces.size(); ++f) out.row(static_cast<Eigen::Index>(f)) << faces[f][0], faces[f][1], faces[f][2];
   return out;

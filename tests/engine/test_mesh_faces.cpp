@@ -1,5 +1,6 @@
-// Face matching, pieces and the nearest-point grid give exactly what the whole-mesh routines
-// they replace in the pass give: cutting::tetComponents, cutting::boundaryFaces, a linear scan.
+// The face adjacency kept across a cut and the free pieces found near it give exactly what
+// the whole-mesh routines give (cutting::matchFaces, cutting::tetPieces), and the
+// nearest-point grid what a linear scan gives. (matchFaces itself: tests/cutting/test_tet_faces.cpp.)
 #include "hysim/engine/mesh_faces.hpp"
 
 #include <gtest/gtest.h>
@@ -14,59 +15,6 @@ namespace hysim::engine {
 namespace {
 
 using Vec3 = Eigen::Vector3d;
-
-// Components, free flags and boundary of `mesh` both ways, anchored = nodes with z < 0.3.
-void expectSameAsCutting(const cutting::TetMesh& mesh) {
-  std::vector<int> anchored;
-  std::vector<std::uint8_t> flags(static_cast<size_t>(mesh.numNodes()), 0);
-  for (int i = 0; i < mesh.numNodes(); ++i)
-    if (mesh.X(i, 2) < 0.3) {
-      anchored.push_back(i);
-      flags[i] = 1;
-    }
-  std::vector<int> next;
-  ASSERT_TRUE(matchFaces(mesh, next));
-  ASSERT_EQ(next.size(), 4 * static_cast<size_t>(mesh.numTets()));
-  const Pieces pieces = tetPieces(mesh, next, flags);
-  const cutting::Components3D comps = cutting::tetComponents(mesh, anchored);
-  ASSERT_EQ(pieces.count, comps.count);
-  for (int t = 0; t < mesh.numTets(); ++t) EXPECT_EQ(pieces.label[t], comps.label[t]) << t;
-  for (int c = 0; c < comps.count; ++c) EXPECT_EQ(pieces.free[c] != 0, static_cast<bool>(comps.free[c])) << c;
-  std::vector<std::uint8_t> boundary(next.size());
-  for (size_t s = 0; s < next.size(); ++s) boundary[s] = next[s] < 0;
-  cutting::Tris faces;
-  Eigen::VectorXi face_tet;
-  boundaryFromSlots(mesh, boundary, faces, face_tet);
-  Eigen::VectorXi expected_tet;
-  const cutting::Tris expected = cutting::boundaryFaces(mesh, &expected_tet);
-  EXPECT_EQ(faces, expected);
-  EXPECT_EQ(face_tet, expected_tet);
-}
-
-TEST(MeshFaces, SameAsCuttingOnABox) { expectSameAsCutting(testing::boxTetMesh(4, 4, 4, 0.5)); }
-
-TEST(MeshFaces, SameAsCuttingAfterThroughAndPartialCuts) {
-  const auto box = testing::boxTetMesh(5, 5, 5, 0.4);
-  // Through: the top comes off as a free piece.
-  auto through = cutting::cut3d(box, *cutting::CutSurface::plane(Vec3(1.0, 1.0, 1.13), Vec3(0.2, 0.1, 1)));
-  ASSERT_TRUE(through.ok()) << through.error();
-  EXPECT_GE(cutting::tetComponents(through->mesh).count, 2);
-  expectSameAsCutting(through->mesh);
-  // Partial: a triangle strip into the side, the pieces stay connected.
-  cutting::Positions v(4, 3);
-  v << -0.5, -0.5, 1.07, 1.1, -0.5, 1.07, -0.5, 2.5, 1.07, 1.1, 2.5, 1.07;
-  cutting::Tris f(2, 3);
-  f << 0, 1, 3, 0, 3, 2;
-  auto partial = cutting::cut3d(box, *cutting::CutSurface::triangles(v, f));
-  ASSERT_TRUE(partial.ok()) << partial.error();
-  expectSameAsCutting(partial->mesh);
-}
-
-TEST(MeshFaces, SameAsCuttingOnTheUterus) {
-  auto mesh = cutting::readTetMesh(std::string(HYSIM_SOURCE_DIR) + "/assets/uterus_myoma.msh");
-  ASSERT_TRUE(mesh.ok()) << mesh.error();
-  expectSameAsCutting(*mesh);
-}
 
 // The cut surface of the tests below: the plane through c with normal n or, when `quad`, a
 // nearly flat quad around c (corners 3 d below and d above c in x and y) that ends inside
@@ -181,31 +129,6 @@ TEST(MeshFaces, FreePiecesNearTheCutAreThoseOfAllTets) {
   }
   EXPECT_EQ(cuts, 12);
   EXPECT_GE(freed, 4);
-}
-
-TEST(MeshFaces, AFaceSharedByThreeTetsJoinsThemAll) {
-  // Not a valid mesh, but cutting::tetComponents joins all the tets of a face: so must this.
-  cutting::TetMesh m;
-  m.X.resize(7, 3);
-  m.X << 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0.2, 0.2, 1, 0.1, 0.3, -1, 5, 5, 5;
-  m.T.resize(4, 4);
-  m.T << 6, 3, 4, 5, 0, 1, 2, 3, 3, 4, 5, 6, 0, 2, 1, 5;
-  m.T.row(0) << 6, 4, 5, 3;
-  m.T.row(2) << 1, 2, 0, 4;  // (0, 1, 2) in tets 1, 2 and 3; tet 0 apart
-  m.material = cutting::Labels::Ones(4);
-  expectSameAsCutting(m);
-  std::vector<int> next;
-  ASSERT_TRUE(matchFaces(m, next));
-  const Pieces p = tetPieces(m, next, std::vector<std::uint8_t>(7, 0));
-  EXPECT_EQ(p.count, 2);
-}
-
-TEST(MeshFaces, RejectsMissingNodes) {
-  auto box = testing::boxTetMesh(2, 2, 2, 0.5);
-  box.T(0, 0) = box.numNodes();
-  std::vector<int> next{7};
-  EXPECT_FALSE(matchFaces(box, next));
-  EXPECT_EQ(next, std::vector<int>{7});
 }
 
 TEST(MeshFaces, NearestPointMatchesALinearScan) {

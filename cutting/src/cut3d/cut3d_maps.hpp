@@ -6,6 +6,8 @@
 #include <utility>
 #include <vector>
 
+#include "hysim/cutting/tet_faces.hpp"
+
 namespace hysim::cutting::cut3d_detail {
 
 using Vec3 = Eigen::Vector3d;
@@ -109,7 +111,7 @@ inline FaceKey makeFace(std::int32_t a, std::int32_t b, std::int32_t c) {
 }
 
 // Outward faces of a positive tet, by the local index of the opposite vertex.
-inline constexpr int kFace[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
+inline constexpr const auto& kFace = kTetFace;
 inline constexpr int kEdge[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
 // The three faces of a tet containing its vertex k, each by its two other vertices.
 inline constexpr int kFacePairs[4][3][2] = {{{2, 3}, {1, 3}, {1, 2}},

@@ -1,17 +1,13 @@
 // Whole-mesh queries on a cut's result: volume, components, the side checks of a plane cut.
 #include <algorithm>
 #include <numeric>
-#include <unordered_map>
 
 #include "cut3d_maps.hpp"
 #include "hysim/cutting/cut3d.hpp"
+#include "hysim/cutting/tet_faces.hpp"
 
 namespace hysim::cutting {
 
-using cut3d_detail::FaceKey;
-using cut3d_detail::FaceKeyHash;
-using cut3d_detail::kFace;
-using cut3d_detail::makeFace;
 using cut3d_detail::Vec3;
 
 double totalVolume(const TetMesh& mesh) {
@@ -21,49 +17,23 @@ double totalVolume(const TetMesh& mesh) {
 }
 
 Components3D tetComponents(const TetMesh& mesh, const std::vector<int>& anchored) {
-  Components3D c;
   const int M = std::max(0, mesh.numTets());
-  c.label = Eigen::VectorXi::Constant(M, -1);
-  // Faces sorted by key; equal neighbours share a face.
-  struct F {
-    std::array<std::int32_t, 3> v;
-    std::int32_t tet;
-  };
-  std::vector<F> faces;
-  faces.reserve(4 * static_cast<size_t>(M));
-  for (int t = 0; t < M; ++t)
-    for (int f = 0; f < 4; ++f) {
-      FaceKey k = makeFace(mesh.T(t, kFace[f][0]), mesh.T(t, kFace[f][1]), mesh.T(t, kFace[f][2]));
-      faces.push_back({k.v, t});
-    }
-  std::sort(faces.begin(), faces.end(), [](const F& x, const F& y) { return x.v < y.v; });
-  std::vector<int> parent(static_cast<size_t>(M));
-  std::iota(parent.begin(), parent.end(), 0);
-  auto find = [&](int x) {
-    while (parent[x] != x) x = parent[x] = parent[parent[x]];
-    return x;
-  };
-  for (size_t i = 0; i + 1 < faces.size(); ++i)
-    if (faces[i].v == faces[i + 1].v) parent[find(faces[i].tet)] = find(faces[i + 1].tet);
-  std::vector<int> id(static_cast<size_t>(M), -1);
-  for (int t = 0; t < M; ++t) {
-    const int r = find(t);
-    if (id[r] < 0) {
-      id[r] = c.count++;
-      c.volume.push_back(0.0);
-      c.elements.push_back(0);
-    }
-    c.label(t) = id[r];
-    c.volume[id[r]] += tetVolume(mesh, t);
-    ++c.elements[id[r]];
-  }
-  c.free.assign(c.count, true);
-  std::vector<std::uint8_t> isAnchored(mesh.numNodes(), 0);
+  std::vector<int> next;
+  matchFacesOfAnyIds(mesh, next);
+  std::vector<std::uint8_t> isAnchored(static_cast<size_t>(mesh.numNodes()), 0);
   for (int n : anchored)
     if (n >= 0 && n < mesh.numNodes()) isAnchored[n] = 1;
-  for (int t = 0; t < M; ++t)
-    for (int k = 0; k < 4; ++k)
-      if (isAnchored[mesh.T(t, k)]) c.free[c.label(t)] = false;
+  const Pieces pieces = tetPieces(mesh, next, isAnchored);
+  Components3D c;
+  c.count = pieces.count;
+  c.label = Eigen::Map<const Eigen::VectorXi>(pieces.label.data(), M);
+  c.volume.assign(static_cast<size_t>(c.count), 0.0);
+  c.elements.assign(static_cast<size_t>(c.count), 0);
+  for (int t = 0; t < M; ++t) {
+    c.volume[pieces.label[t]] += tetVolume(mesh, t);
+    ++c.elements[pieces.label[t]];
+  }
+  c.free.assign(pieces.free.begin(), pieces.free.end());
   return c;
 }
 
@@ -93,14 +63,14 @@ int countFacesSharedAcross(const TetMesh& mesh, const Eigen::Vector3d& point, co
     }
     return best > eps ? 1 : best < -eps ? -1 : 0;
   };
-  std::unordered_map<FaceKey, int, FaceKeyHash> owner;
+  std::vector<int> next;
+  matchFacesOfAnyIds(mesh, next);
   int count = 0;
-  for (int t = 0; t < mesh.numTets(); ++t)
-    for (int f = 0; f < 4; ++f) {
-      const FaceKey k = makeFace(mesh.T(t, kFace[f][0]), mesh.T(t, kFace[f][1]), mesh.T(t, kFace[f][2]));
-      auto [it, inserted] = owner.emplace(k, t);
-      if (!inserted && tetSide(it->second) * tetSide(t) < 0) ++count;
-    }
+  // Each later tet of a face against the face's first (lowest) tet.
+  for (int s = 0; s < static_cast<int>(next.size()); ++s) {
+    const int first = firstSlotOfFace(next, s);
+    if (first != s && tetSide(first / 4) * tetSide(s / 4) < 0) ++count;
+  }
   return count;
 }
 

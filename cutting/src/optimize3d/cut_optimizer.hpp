@@ -33,11 +33,12 @@
 #include "../optimize3d_internal.hpp"
 #include "../tet_geometry_inline.hpp"
 #include "hysim/cutting/tet_mesh_editor.hpp"
+#include "hysim/cutting/tet_faces.hpp"
 
 namespace hysim::cutting::opt3d {
 
 using Vec3 = Eigen::Vector3d;
-inline constexpr int kFace[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
+inline constexpr const auto& kFace = kTetFace;
 
 enum class Freedom { Free, Plane, Surface, Fan, Ridge, Fixed };
 

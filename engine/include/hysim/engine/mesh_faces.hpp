@@ -1,28 +1,25 @@
 #pragma once
-// Face matching and connected pieces of a tet mesh in linear time, and a nearest-point grid,
-// for the pass after a cut (Simulation::finishPass). They give exactly what the whole-mesh
-// routines they replace give (cutting::tetComponents' labels, cutting::boundaryFaces' faces
-// and order, a linear nearest-point scan), see tests/engine/test_mesh_faces.cpp.
+// The face adjacency kept current across a cut, the free pieces found near the cut, and a
+// nearest-point grid, for the pass after a cut (Simulation::finishPass). They give exactly
+// what the whole-mesh routines give (cutting::matchFaces' next, cutting::tetPieces' pieces, a
+// linear nearest-point scan), see tests/engine/test_mesh_faces.cpp.
 #include <Eigen/Core>
 #include <cstdint>
 #include <vector>
 
 #include "hysim/cutting/mesh.hpp"
+#include "hysim/cutting/tet_faces.hpp"
 #include "hysim/sim/model.hpp"
 
 namespace hysim::engine {
 
-// The four faces of a tet as local vertex indices, face k opposite vertex k, oriented
-// outwards for a positive tet: the order cutting::boundaryFaces uses.
-inline constexpr int kTetFace[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
-
-// Slot s = 4 t + k is face k of tet t; next[s] (4 #T) is another slot with the same three
-// nodes (the slots of a shared face form a cycle, in ascending slot order), or -1 where the
-// face is on the boundary.
-// Faces are bucketed by their smallest node (a counting sort), then sorted by the other two
-// inside each bucket (a few dozen faces). Returns false (next untouched) for node ids
-// outside [0, #N), which a valid mesh never has.
-bool matchFaces(const cutting::TetMesh& mesh, std::vector<int>& next);
+// The face adjacency itself (kTetFace, matchFaces, tetPieces, boundaryFromSlots) is cutting's
+// (hysim/cutting/tet_faces.hpp); this file keeps it current across a cut.
+using cutting::boundaryFromSlots;
+using cutting::kTetFace;
+using cutting::matchFaces;
+using cutting::Pieces;
+using cutting::tetPieces;
 
 // matchFaces' next for `after`, a cut of `before` (change: the cut's TopologyChange), from
 // next_before (matchFaces' next of before) instead of from all faces: a slot of an element
@@ -48,17 +45,6 @@ bool updateFaces(const cutting::TetMesh& before, const std::vector<int>& next_be
                  const std::vector<std::int32_t>& node_old_to_new, const std::vector<std::int32_t>& element_old_to_new,
                  std::vector<int>& next, FaceChange* change = nullptr);
 
-// Connected components through shared faces, numbered in the order of their first tet, and
-// whether each touches no anchored node: cutting::tetComponents' label, count and free (not
-// its volumes), from matchFaces' next.
-struct Pieces {
-  std::vector<int> label;  // #T
-  int count = 0;
-  std::vector<std::uint8_t> free;  // per component
-};
-// anchored: #N flags.
-Pieces tetPieces(const cutting::TetMesh& mesh, const std::vector<int>& next, const std::vector<std::uint8_t>& anchored);
-
 // Per tet, the number of steps through shared faces to a tet with an anchored node (0 for
 // those), or INT_MAX where no such tet is connected. A breadth-first search from all of them.
 std::vector<int> anchorDistance(const cutting::TetMesh& mesh, const std::vector<int>& next,
@@ -81,11 +67,6 @@ std::vector<int> anchorDistance(const cutting::TetMesh& mesh, const std::vector<
 Pieces freePiecesAfterCut(const cutting::TetMesh& after, const std::vector<int>& next,
                           const std::vector<std::uint8_t>& anchored, const FaceChange& change,
                           const std::vector<int>& distance_before);
-
-// The boundary faces (the slots whose next is -1) in slot order, nodes in kTetFace order,
-// and their tets: what cutting::boundaryFaces gives for the mesh. boundary: 4 #T flags.
-void boundaryFromSlots(const cutting::TetMesh& mesh, const std::vector<std::uint8_t>& boundary, cutting::Tris& faces,
-                       Eigen::VectorXi& face_tet);
 
 // Nearest point of a set to a query, exactly as a linear scan in the set's order finds it
 // (smallest squared distance, the first such point on ties), through a uniform grid.
