@@ -21,6 +21,20 @@ std::string hashHex(std::uint64_t hash) {
   return buf;
 }
 
+namespace {
+
+nlohmann::ordered_json assessmentJson(const Assessment& a) {
+  nlohmann::ordered_json items = nlohmann::ordered_json::array();
+  for (const AssessmentItem& i : a.items) {
+    items.push_back({{"name", i.name}, {"value", i.value}, {"threshold", i.threshold},
+                     {"rule", i.at_least ? "at_least" : "at_most"}, {"unit", i.unit}, {"passed", i.passed},
+                     {"score", i.score}, {"weight", i.weight}});
+  }
+  return {{"score", a.score}, {"passed", a.passed}, {"items", items}};
+}
+
+}  // namespace
+
 RunSummary summarize(const RunReport& r) {
   RunSummary s;
   double removed = 0.0;
@@ -42,6 +56,8 @@ RunSummary summarize(const RunReport& r) {
   s.path_length_mm = r.path_length_mm;
   s.cut_ms_median = percentile(cut_ms, 0.5);
   s.cut_ms_max = cut_ms.empty() ? 0.0 : *std::max_element(cut_ms.begin(), cut_ms.end());
+  s.assessment = assess(r.assessment_settings, AssessedOutcome{s.myoma_resected_pct, s.healthy_removed_mm3, s.perforations,
+                                                               r.steps * r.dt});
   return s;
 }
 
@@ -57,7 +73,7 @@ std::string summaryText(const RunReport& r) {
                 "path length       %.0f mm\n",
                 s.myoma_resected_mm3, s.myoma_resected_pct, r.initial_myoma_mm3, s.healthy_removed_mm3, s.perforations,
                 r.perforation_margin_mm, s.passes, s.cut_ms_median, s.cut_ms_max, s.electrode_active_s, s.path_length_mm);
-  return buf;
+  return buf + assessmentText(s.assessment);
 }
 
 std::string reportJson(const RunReport& r) {
@@ -159,6 +175,7 @@ std::string reportJson(const RunReport& r) {
     events.push_back({{"time_s", e.time_s}, {"end_s", e.end_s}, {"min_distance_mm", e.min_distance_mm}});
   }
   j["perforation_events"] = events;
+  j["assessment"] = assessmentJson(sum.assessment);
   j["chips"] = {{"mode", r.chips_mode}, {"in_cavity", r.chips_in_cavity}, {"left_cavity", r.chips_left_cavity},
                 {"over_cap", r.chips_over_cap}, {"step_us_mean", r.chip_step_us_mean}};
   const haptics::DeviceCounters& c = r.device_counters;

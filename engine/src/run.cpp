@@ -30,6 +30,7 @@ const char* integratorName(sim::Integrator integrator) {
 void describe(const Simulation& sim, RunReport& r) {
   const Scene& scene = sim.scene();
   r.scene = scene.name;
+  r.assessment_settings = scene.assessment;
   r.dt = scene.sim.dt;
   r.nodes = sim.mesh().numNodes();
   r.elements = sim.mesh().numTets();

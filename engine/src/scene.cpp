@@ -270,13 +270,56 @@ void parseCoupling(const Reader& r, const YAML::Node& n, CouplingSettings& c) {
   if (n["damping_n_s_per_mm"]) c.damping_n_s_per_mm = r.positive(n["damping_n_s_per_mm"], "damping_n_s_per_mm");
 }
 
+// The instructor's thresholds and weights (assessment.hpp); a weight of 0 leaves an item out
+// of the score, but all of them 0 would leave no score.
+void parseAssessment(const Reader& r, const YAML::Node& n, AssessmentSettings& a) {
+  r.checkKeys(n, "assessment", {"min_resected_pct", "max_healthy_removed_mm3", "perforations_allowed", "time_limit_s",
+                                "weights"});
+  if (n["min_resected_pct"]) {
+    a.min_resected_pct = r.nonNegative(n["min_resected_pct"], "min_resected_pct");
+    if (a.min_resected_pct > 100.0) {
+      r.fail(n["min_resected_pct"], "'min_resected_pct' must be at most 100, got " + n["min_resected_pct"].Scalar());
+    }
+  }
+  if (n["max_healthy_removed_mm3"]) a.max_healthy_removed_mm3 = r.nonNegative(n["max_healthy_removed_mm3"], "max_healthy_removed_mm3");
+  if (n["perforations_allowed"]) a.perforations_allowed = r.integer(n["perforations_allowed"], "perforations_allowed", 0, 1000);
+  if (n["time_limit_s"]) a.time_limit_s = r.positive(n["time_limit_s"], "time_limit_s");
+  if (!n["weights"]) return;
+  const YAML::Node w = n["weights"];
+  r.checkKeys(w, "assessment.weights", {"resection", "healthy", "safety", "time"});
+  if (w["resection"]) a.weights.resection = r.nonNegative(w["resection"], "resection");
+  if (w["healthy"]) a.weights.healthy = r.nonNegative(w["healthy"], "healthy");
+  if (w["safety"]) a.weights.safety = r.nonNegative(w["safety"], "safety");
+  if (w["time"]) a.weights.time = r.nonNegative(w["time"], "time");
+  if (!(a.weights.resection + a.weights.healthy + a.weights.safety + a.weights.time > 0.0)) {
+    r.fail(w, "'assessment.weights' must not all be 0");
+  }
+}
+
+// The case as the start screen lists it: FIGO type (0-7, or 2-5 for the hybrid) and difficulty.
+void parseCase(const Reader& r, const YAML::Node& root, Scene& scene) {
+  if (root["figo_type"]) {
+    const std::string t = r.string(root["figo_type"], "figo_type");
+    static const std::set<std::string> kTypes = {"0", "1", "2", "3", "4", "5", "6", "7", "2-5"};
+    if (!kTypes.count(t)) r.fail(root["figo_type"], "'figo_type' must be 0 to 7 or 2-5, got '" + t + "'");
+    scene.figo_type = t;
+  }
+  if (root["difficulty"]) {
+    const std::string d = r.string(root["difficulty"], "difficulty");
+    if (d != "beginner" && d != "intermediate" && d != "advanced") {
+      r.fail(root["difficulty"], "'difficulty' must be beginner, intermediate or advanced, got '" + d + "'");
+    }
+    scene.difficulty = d;
+  }
+}
+
 Scene parse(const Reader& r, const YAML::Node& root, const std::string& path) {
   Scene scene;
   scene.path = path;
   if (!root.IsDefined() || root.IsNull()) r.fail(root, "the scene file is empty");
   r.checkKeys(root, "scene", {"name", "description", "mesh", "tool_mesh", "materials", "anchors", "simulation",
                               "contact", "safety", "tool_path", "camera", "render", "chips", "cut",
-                              "coupling"});
+                              "coupling", "figo_type", "difficulty", "assessment"});
   const fs::path dir = fs::path(path).parent_path();
   auto resolve = [&](const YAML::Node& n, const std::string& key) {
     const std::string rel = r.string(n, key);
@@ -287,6 +330,8 @@ Scene parse(const Reader& r, const YAML::Node& root, const std::string& path) {
   };
   scene.name = r.string(r.require(root, "name", "scene"), "name");
   if (root["description"]) scene.description = r.string(root["description"], "description");
+  parseCase(r, root, scene);
+  if (root["assessment"]) parseAssessment(r, root["assessment"], scene.assessment);
   scene.mesh_path = resolve(r.require(root, "mesh", "scene"), "mesh");
   if (root["tool_mesh"]) scene.tool_mesh_path = resolve(root["tool_mesh"], "tool_mesh");
 

@@ -195,6 +195,18 @@ TEST(Perforation, CarelessPassBehindTheType2MyomaPerforates) {
   const std::string text = summaryText(*report);
   EXPECT_NE(text.find("perforations      1"), std::string::npos) << text;
   EXPECT_NE(text.find("myoma resected"), std::string::npos) << text;
+  // The scene's assessment allows no perforation: safety is not met, the run fails.
+  const Assessment& a = summarize(*report).assessment;
+  EXPECT_FALSE(a.passed);
+  for (const AssessmentItem& i : a.items) {
+    if (i.name == "safety") {
+      EXPECT_FALSE(i.passed);
+    } else if (i.name == "time") {
+      EXPECT_TRUE(i.passed);
+    }
+  }
+  EXPECT_NE(json.find("\"assessment\": {"), std::string::npos);
+  EXPECT_NE(text.find("FAIL"), std::string::npos) << text;
 }
 
 // The deepest pass of scenes/type2_safe.yaml (pass 4, from its 22nd keyframe) stays clear.

@@ -82,6 +82,46 @@ TEST(Scene, MinimalSceneLoadsWithDefaults) {
   EXPECT_NEAR(scene->materials[1].density_g_mm3, 1.1e-3, 1e-15);
 }
 
+TEST(Scene, AssessmentAndCaseParse) {
+  const std::string text = minimalScene() +
+                           "figo_type: 2-5\n"
+                           "difficulty: advanced\n"
+                           "assessment:\n"
+                           "  min_resected_pct: 70\n"
+                           "  max_healthy_removed_mm3: 120\n"
+                           "  perforations_allowed: 1\n"
+                           "  time_limit_s: 300\n"
+                           "  weights: {resection: 1, healthy: 0, safety: 2, time: 0.5}\n";
+  auto scene = loadScene(writeFile("assessment.yaml", text));
+  ASSERT_TRUE(scene.ok()) << scene.error();
+  EXPECT_EQ(scene->figo_type, "2-5");
+  EXPECT_EQ(scene->difficulty, "advanced");
+  EXPECT_EQ(scene->assessment.min_resected_pct, 70.0);
+  EXPECT_EQ(scene->assessment.max_healthy_removed_mm3, 120.0);
+  EXPECT_EQ(scene->assessment.perforations_allowed, 1);
+  EXPECT_EQ(scene->assessment.time_limit_s, 300.0);
+  EXPECT_EQ(scene->assessment.weights.safety, 2.0);
+  EXPECT_EQ(scene->assessment.weights.healthy, 0.0);
+  // Without the section: the documented defaults.
+  auto plain = loadScene(writeFile("no_assessment.yaml", minimalScene()));
+  ASSERT_TRUE(plain.ok()) << plain.error();
+  EXPECT_EQ(plain->assessment.min_resected_pct, AssessmentSettings{}.min_resected_pct);
+  EXPECT_TRUE(plain->figo_type.empty());
+}
+
+TEST(SceneErrors, BadAssessmentOrCase) {
+  const std::string base = minimalScene() + "assessment:\n";  // line 11
+  expectError("assess_pct.yaml", base + "  min_resected_pct: 120\n", ":12:", "'min_resected_pct' must be at most 100");
+  expectError("assess_neg.yaml", base + "  time_limit_s: -5\n", ":12:", "'time_limit_s' must be positive");
+  expectError("assess_key.yaml", base + "  max_time: 5\n", ":12:", "unknown key 'max_time' in 'assessment'");
+  expectError("assess_perf.yaml", base + "  perforations_allowed: 1.5\n", ":12:", "'perforations_allowed' must be an integer");
+  expectError("assess_w.yaml", base + "  weights: {resection: 0, healthy: 0, safety: 0, time: 0}\n", ":12:",
+              "'assessment.weights' must not all be 0");
+  expectError("assess_nan.yaml", base + "  weights: {time: .nan}\n", ":12:", "'time' must be finite");
+  expectError("figo.yaml", minimalScene() + "figo_type: 9\n", ":11:", "'figo_type' must be 0 to 7 or 2-5, got '9'");
+  expectError("difficulty.yaml", minimalScene() + "difficulty: hard\n", ":11:", "'difficulty' must be beginner");
+}
+
 TEST(SceneErrors, BadYaml) {
   expectError("bad_yaml.yaml", replaceLine(minimalScene(), 7, "  dt_ms: [1.0"), ":", "YAML error");
 }

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "hysim/engine/assessment.hpp"
 #include "hysim/engine/simulation.hpp"
 
 namespace hysim::engine {
@@ -33,6 +34,7 @@ double percentile(std::vector<double> values, double p);
 
 struct RunReport {
   std::string scene;
+  AssessmentSettings assessment_settings;  // the scene's
   std::string integrator;
   int steps = 0;
   double dt = 0.0;             // s
@@ -105,6 +107,7 @@ struct RunSummary {
   double electrode_active_s = 0.0;
   double path_length_mm = 0.0;
   double cut_ms_median = 0.0, cut_ms_max = 0.0;
+  Assessment assessment;  // of the run's outcome, its duration the simulated time
 };
 RunSummary summarize(const RunReport& report);
 // A few lines of text with the summary's numbers.

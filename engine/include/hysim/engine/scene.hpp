@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "hysim/cutting/result.hpp"
+#include "hysim/engine/assessment.hpp"
 #include "hysim/haptics/trajectory.hpp"
 #include "hysim/sim/model.hpp"
 
@@ -93,6 +94,9 @@ struct Scene {
   std::string path;        // the scene file
   std::string name;
   std::string description;
+  std::string figo_type;   // "0".."7" or "2-5"; empty: not given
+  std::string difficulty;  // beginner, intermediate or advanced; empty: not given
+  AssessmentSettings assessment;
   std::string mesh_path;   // resolved against the scene file's folder
   std::string tool_mesh_path;  // optional; empty = no tool surface drawn
   std::vector<sim::Material> materials;
