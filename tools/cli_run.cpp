@@ -26,34 +26,6 @@ int fail(const std::string& message) {
   return 1;
 }
 
-// Writes through a temporary file and a rename, so an existing report is never left
-// half-written.
-Status writeFileAtomically(const std::string& path, const std::string& text) {
-  const std::string tmp = path + ".tmp";
-  std::error_code dir_ec;
-  const fs::path parent = fs::path(path).parent_path();
-  if (!parent.empty()) fs::create_directories(parent, dir_ec);
-  if (dir_ec) return Error{"cannot create folder '" + parent.string() + "': " + dir_ec.message()};
-  bool written = false;
-  {
-    std::ofstream out(tmp, std::ios::binary);
-    out << text;
-    written = static_cast<bool>(out.flush());
-  }
-  std::error_code ec;
-  if (!written) {
-    fs::remove(tmp, ec);
-    return Error{"cannot write '" + tmp + "'"};
-  }
-  fs::rename(tmp, path, ec);
-  if (ec) {
-    std::error_code ignored;
-    fs::remove(tmp, ignored);
-    return Error{"cannot move '" + tmp + "' to '" + path + "': " + ec.message()};
-  }
-  return Status::Ok();
-}
-
 // Frames into `folder` (PNG through the headless renderer); nothing when `folder` is empty.
 Status setUpFrames(const engine::Scene& scene, const std::string& folder,
                    std::unique_ptr<render::OffscreenRenderer>& renderer, engine::RunOptions& options) {
