@@ -5,15 +5,16 @@
 
 #include <string>
 
+#include "hysim/cutting/input_file.hpp"
 #include "hysim/cutting/result.hpp"
 
 namespace hysim::tools {
 
 inline Result<YAML::Node> loadYamlFile(const std::string& path) {
+  Result<std::string> text = readInputFile(path, kMaxYamlFileBytes, "YAML");
+  if (!text.ok()) return Error{text.error()};
   try {
-    return YAML::LoadFile(path);
-  } catch (const YAML::BadFile&) {
-    return Error{path + ": cannot open"};
+    return YAML::Load(*text);
   } catch (const YAML::Exception& e) {
     return Error{path + ":" + std::to_string(e.mark.line + 1) + ": " + e.msg};
   }
