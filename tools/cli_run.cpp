@@ -26,9 +26,22 @@ int fail(const std::string& message) {
   return 1;
 }
 
+// A report path must name a file. Checked before a run, so that a long run does not end in
+// this error, and again before writing.
+Status checkReportPath(const std::string& path) {
+  if (path.empty()) return Status::Ok();
+  std::error_code ec;
+  if (!fs::path(path).has_filename() || fs::is_directory(path, ec)) {
+    return Error{"--report '" + path + "' names a folder; give a file, e.g. '" +
+                 (fs::path(path) / "report.json").lexically_normal().string() + "'"};
+  }
+  return Status::Ok();
+}
+
 // Writes through a temporary file and a rename, so an existing report is never left
-// half-written.
+// half-written; on any failure the temporary file is removed.
 Status writeFileAtomically(const std::string& path, const std::string& text) {
+  if (Status st = checkReportPath(path); !st.ok()) return st;
   const std::string tmp = path + ".tmp";
   std::error_code dir_ec;
   const fs::path parent = fs::path(path).parent_path();
@@ -43,7 +56,7 @@ Status writeFileAtomically(const std::string& path, const std::string& text) {
   std::error_code ec;
   if (!written) {
     fs::remove(tmp, ec);
-    return Error{"cannot write '" + tmp + "'"};
+    return Error{"cannot write the report '" + path + "' (through '" + tmp + "')"};
   }
   fs::rename(tmp, path, ec);
   if (ec) {
@@ -136,6 +149,7 @@ int finishRun(const engine::RunReport& r, const std::string& frames, const std::
 }
 
 int runCommand(const RunArgs& args) {
+  if (Status st = checkReportPath(args.report); !st.ok()) return fail(st.error());
   const std::string scene_path = args.scene.empty() ? tools::defaultScenePath() : args.scene;
   auto scene = engine::loadScene(scene_path);
   if (!scene.ok()) return fail(scene.error());
@@ -183,6 +197,7 @@ int runCommand(const RunArgs& args) {
 }
 
 int replayCommand(const ReplayArgs& args) {
+  if (Status st = checkReportPath(args.report); !st.ok()) return fail(st.error());
   auto recording = std::make_shared<haptics::Recording>();
   std::string error;
   if (!haptics::readRecording(args.recording, *recording, error)) return fail(error);
@@ -211,14 +226,14 @@ int replayCommand(const ReplayArgs& args) {
 // What run and replay write, and how much they say.
 void addOutputOptions(CLI::App& cmd, std::string& frames, int& every, std::string& report, bool& quiet) {
   cmd.add_option("--frames", frames, "Write PNG frames into this folder");
-  cmd.add_option("--every", every, "Render a frame every K steps (default: the scene's)")->check(CLI::PositiveNumber);
+  cmd.add_option("--every", every, "Render a frame every K steps (default: the scene's)")->check(finiteRange(1, 1e6));
   cmd.add_option("--report", report, "Write the JSON report to this file");
   cmd.add_flag("--quiet", quiet, "Print nothing but errors");
 }
 
 void addRunOptions(CLI::App& cmd, RunArgs& run) {
   cmd.add_option("scene", run.scene, "Scene file (default: scenes/default.yaml)")->check(CLI::ExistingFile);
-  cmd.add_option("--steps", run.steps, "Number of steps (default: the scene's)")->check(CLI::NonNegativeNumber);
+  cmd.add_option("--steps", run.steps, "Number of steps (default: the scene's)")->check(finiteRange(0, 1e8));
   addOutputOptions(cmd, run.frames, run.every, run.report, run.quiet);
   cmd.add_option("--chips", run.chips, "Override the scene's chips mode: remove or simulate")
       ->check(CLI::IsMember({"remove", "simulate"}));
@@ -238,7 +253,7 @@ void addRunOptions(CLI::App& cmd, RunArgs& run) {
                  "haptics/README.md)")
       ->check(CLI::ExistingFile);
   cmd.add_option("--device-wait-s", run.device_wait_s, "udp: seconds to wait for the bridge's first packet")
-      ->check(CLI::Range(0.0, 3600.0));
+      ->check(finiteRange(0.0, 3600.0));
   cmd.add_option("--gamepad-mapping", run.gamepad_mapping, "Game controller mapping file (haptics/README.md)")
       ->check(CLI::ExistingFile);
   cmd.add_flag("--realtime", run.realtime,

@@ -1,5 +1,10 @@
 #include "tool_common.hpp"
 
+#include <algorithm>
+#include <cctype>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
 #include <filesystem>
 
 namespace hysim::tools {
@@ -24,6 +29,60 @@ nlohmann::ordered_json statsJson(const cutting::MeshStats& s) {
   j["q_std"] = s.q_std;
   j["dihedral_min_deg"] = s.dihedral_min_deg;
   return j;
+}
+
+namespace {
+
+std::string numberText(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g", v);
+  return text;
+}
+
+}  // namespace
+
+CLI::Validator finiteRange(double lo, double hi) {
+  const std::string range = "[" + numberText(lo) + ", " + numberText(hi) + "]";
+  return CLI::Validator(
+      [lo, hi, range](std::string& input) -> std::string {
+        double value = 0.0;
+        const char* end = input.data() + input.size();
+        const auto [stop, ec] = std::from_chars(input.data(), end, value);
+        if (ec != std::errc() || stop != end || !std::isfinite(value)) {
+          return "'" + input + "' is not a finite number";
+        }
+        if (value < lo || value > hi) return "'" + input + "' is not in " + range;
+        return {};
+      },
+      "NUMBER in " + range);
+}
+
+Result<std::vector<double>> parseNumberList(const std::string& option, const std::string& text, int count,
+                                            const std::string& expected, double max_abs) {
+  std::vector<double> values;
+  std::size_t begin = 0;
+  while (begin <= text.size()) {
+    const std::size_t comma = std::min(text.find(',', begin), text.size());
+    std::string item = text.substr(begin, comma - begin);
+    while (!item.empty() && std::isspace(static_cast<unsigned char>(item.front()))) item.erase(0, 1);
+    while (!item.empty() && std::isspace(static_cast<unsigned char>(item.back()))) item.pop_back();
+    if (!item.empty() && item.front() == '+') item.erase(0, 1);
+    double v = 0.0;
+    const auto [stop, ec] = std::from_chars(item.data(), item.data() + item.size(), v);
+    if (item.empty() || ec == std::errc::invalid_argument || stop != item.data() + item.size()) {
+      return Error{option + ": expected " + expected + ", got '" + text + "'"};
+    }
+    if (ec == std::errc::result_out_of_range || !std::isfinite(v)) {
+      return Error{option + ": value '" + item + "' in '" + text + "' is not a finite number"};
+    }
+    if (std::abs(v) > max_abs) {
+      return Error{option + ": value '" + item + "' in '" + text + "' is beyond +-" + numberText(max_abs)};
+    }
+    values.push_back(v);
+    begin = comma + 1;
+  }
+  if (static_cast<int>(values.size()) != count) return Error{option + ": expected " + expected + ", got '" + text + "'"};
+  return values;
 }
 
 }  // namespace hysim::tools

@@ -236,6 +236,12 @@ bool RecordingWriter::open(const std::string& path, const RecordingHeader& heade
       return false;
     }
   }
+  // A folder cannot take the file: said now, not at the rename after the whole run.
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec) || path.empty() || path.back() == '/') {
+    error = "cannot record into '" + path + "': it names a folder, not a file";
+    return false;
+  }
   path_ = path;
   const std::string tmp = path + ".tmp";
   file_ = std::fopen(tmp.c_str(), "wb");
@@ -291,6 +297,8 @@ bool RecordingWriter::finish(std::string& error) {
   std::filesystem::rename(tmp, path_, ec);
   if (ec) {
     error = "cannot move '" + tmp + "' to '" + path_ + "': " + ec.message();
+    std::error_code ignored;
+    std::filesystem::remove(tmp, ignored);  // nothing half-done is left behind
     return false;
   }
   return true;
