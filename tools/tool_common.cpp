@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <string_view>
 
 namespace hysim::tools {
 
@@ -59,29 +60,34 @@ CLI::Validator finiteRange(double lo, double hi) {
 
 Result<std::vector<double>> parseNumberList(const std::string& option, const std::string& text, int count,
                                             const std::string& expected, double max_abs) {
+  // Commas or spaces separate the values, as the option's help and older scripts write them.
+  std::vector<std::string> items;
+  std::string item;
+  for (const char c : text + ",") {
+    if (c == ',' || std::isspace(static_cast<unsigned char>(c))) {
+      if (!item.empty()) items.push_back(item);
+      item.clear();
+    } else {
+      item += c;
+    }
+  }
+  if (static_cast<int>(items.size()) != count) return Error{option + ": expected " + expected + ", got '" + text + "'"};
   std::vector<double> values;
-  std::size_t begin = 0;
-  while (begin <= text.size()) {
-    const std::size_t comma = std::min(text.find(',', begin), text.size());
-    std::string item = text.substr(begin, comma - begin);
-    while (!item.empty() && std::isspace(static_cast<unsigned char>(item.front()))) item.erase(0, 1);
-    while (!item.empty() && std::isspace(static_cast<unsigned char>(item.back()))) item.pop_back();
-    if (!item.empty() && item.front() == '+') item.erase(0, 1);
+  for (const std::string& token : items) {
+    const std::string_view digits = token.front() == '+' ? std::string_view(token).substr(1) : std::string_view(token);
     double v = 0.0;
-    const auto [stop, ec] = std::from_chars(item.data(), item.data() + item.size(), v);
-    if (item.empty() || ec == std::errc::invalid_argument || stop != item.data() + item.size()) {
-      return Error{option + ": expected " + expected + ", got '" + text + "'"};
+    const auto [stop, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), v);
+    if (digits.empty() || ec == std::errc::invalid_argument || stop != digits.data() + digits.size()) {
+      return Error{option + ": expected " + expected + ", got '" + text + "' ('" + token + "' is not a number)"};
     }
     if (ec == std::errc::result_out_of_range || !std::isfinite(v)) {
-      return Error{option + ": value '" + item + "' in '" + text + "' is not a finite number"};
+      return Error{option + ": value '" + token + "' in '" + text + "' is not a finite number in double range"};
     }
     if (std::abs(v) > max_abs) {
-      return Error{option + ": value '" + item + "' in '" + text + "' is beyond +-" + numberText(max_abs)};
+      return Error{option + ": value '" + token + "' in '" + text + "' is beyond +-" + numberText(max_abs)};
     }
     values.push_back(v);
-    begin = comma + 1;
   }
-  if (static_cast<int>(values.size()) != count) return Error{option + ": expected " + expected + ", got '" + text + "'"};
   return values;
 }
 

@@ -50,8 +50,10 @@ TEST(InputCli, CutValuesMustBeFiniteAndInRange) {
   expectRefused("cut tests/data/cutting/table1_mesh1.msh --line 0,0,1e31,1 --out " + out,
                 {"--line", "'1e31'", "beyond"});
   EXPECT_FALSE(fs::exists(out));
-  // A tiny normal is a direction all the same.
-  const Output o = hysim("cut " + kTetMesh + " --plane 0.5,0.3,0.2,0,0,1e-200 --out " + out);
+  // A tiny normal is a direction all the same; spaces separate values as commas do.
+  Output o = hysim("cut " + kTetMesh + " --plane 0.5,0.3,0.2,0,0,1e-200 --out " + out);
+  EXPECT_EQ(o.exit_code, 0) << o.text;
+  o = hysim("cut " + kTetMesh + " --plane '0.5 0.3 0.2 0 0 1' --out " + out);
   EXPECT_EQ(o.exit_code, 0) << o.text;
 }
 
