@@ -486,6 +486,20 @@ void BM_CutSurfaceBuild(benchmark::State& state) {
 }
 BENCHMARK(BM_CutSurfaceBuild)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->Iterations(20);
 
+// validate() runs after every cut in the tests, so it must stay cheap (O(n log n)) on a 20k-tet
+// mesh; its cost is measured here, where a number informs, instead of bounded in a test, where
+// a shared machine makes any wall-clock bound flaky.
+void BM_ValidateTetMesh(benchmark::State& state) {
+  const auto mesh = hysim::cutting::readTetMesh(std::string(HYSIM_SOURCE_DIR) + "/tests/data/cutting/uterus_20k.msh");
+  if (!mesh.ok()) {
+    state.SkipWithError(mesh.error().c_str());
+    return;
+  }
+  for (auto _ : state) benchmark::DoNotOptimize(hysim::cutting::validate(*mesh, {.requireAllNodesUsed = true}).ok());
+  state.counters["tets"] = mesh->numTets();
+}
+BENCHMARK(BM_ValidateTetMesh)->Unit(benchmark::kMillisecond);
+
 }  // namespace
 
 BENCHMARK_MAIN();

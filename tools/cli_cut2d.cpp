@@ -43,7 +43,7 @@ std::shared_ptr<Cut2dCommands> addCut2dCommands(CLI::App& app) {
   c->tables->add_option("--json", c->table1.json_path, "Write the rows as JSON here");
   c->tables->add_option("--pictures", c->table1.pictures_dir, "Write PNG pictures of each mesh before/after here");
   c->tables->add_option("--meshes", c->table1.meshes_dir, "Write the DistMesh test meshes (.msh) here");
-  c->tables->add_option("--repeats", c->table1.repeats, "Timed runs per cut (median reported)")->check(CLI::PositiveNumber);
+  c->tables->add_option("--repeats", c->table1.repeats, "Timed runs per cut (median reported)")->check(finiteRange(1, 1000));
   return c;
 }
 
@@ -58,18 +58,9 @@ int cutCommand(const Cut2dCommands& c) {
   cutting::Cut2DOptions o;
   if (!cutting::parseCutMethod(c.method, &o.method))
     return fail("--method: unknown method '" + c.method + "' (hybrid, standard, snap, delete)");
-  double v[4];
-  {
-    std::string s = c.line;
-    for (char& ch : s)
-      if (ch == ',') ch = ' ';
-    std::istringstream is(s);
-    std::string extra;
-    if (!(is >> v[0] >> v[1] >> v[2] >> v[3]) || (is >> extra))
-      return fail("--line: expected x0,y0,x1,y1 (four numbers), got '" + c.line + "'");
-    for (double x : v)
-      if (!std::isfinite(x)) return fail("--line: non-finite value in '" + c.line + "'");
-  }
+  auto parsed = parseNumberList("--line", c.line, 4, "x0,y0,x1,y1 (four numbers)", cutting::kMaxCoordinateMm);
+  if (!parsed.ok()) return fail(parsed.error());
+  const std::vector<double>& v = *parsed;
   auto mesh = cutting::readTriMesh(c.in);
   if (!mesh.ok()) return fail(mesh.error());
   if (!mesh->isPlanar()) return fail(c.in + ": not a planar mesh (z must be 0): hysim cut works on 2D meshes");

@@ -27,20 +27,6 @@ int fail(const std::string& m) {
   return 1;
 }
 
-bool parseNumbers(const std::string& text, int count, std::vector<double>* out) {
-  std::string s = text;
-  for (char& ch : s)
-    if (ch == ',') ch = ' ';
-  std::istringstream is(s);
-  out->clear();
-  double v;
-  while (is >> v) out->push_back(v);
-  if (!is.eof() || static_cast<int>(out->size()) != count) return false;
-  for (double x : *out)
-    if (!std::isfinite(x)) return false;
-  return true;
-}
-
 Result<cutting::CutSurface> loadCutSurface(const std::string& path) {
   const bool msh = path.size() > 4 && (path.substr(path.size() - 4) == ".msh" || path.substr(path.size() - 4) == ".vtk");
   if (msh) {
@@ -81,8 +67,11 @@ int runCut3d(const Cut3dArgs& a) {
   if (Status st = cutting::validate(*mesh); !st.ok()) return fail(a.in + ": invalid mesh: " + st.error());
   Result<cutting::CutSurface> surface = Error{""};
   if (!a.plane.empty()) {
-    std::vector<double> v;
-    if (!parseNumbers(a.plane, 6, &v)) return fail("--plane: expected px,py,pz,nx,ny,nz (six numbers), got '" + a.plane + "'");
+    // The normal's size does not matter (it is normalised without overflow), but every value
+    // must be a number a mesh coordinate could be.
+    auto parsed = parseNumberList("--plane", a.plane, 6, "px,py,pz,nx,ny,nz (six numbers)", cutting::kMaxCoordinateMm);
+    if (!parsed.ok()) return fail(parsed.error());
+    const std::vector<double>& v = *parsed;
     surface = cutting::CutSurface::plane(Eigen::Vector3d(v[0], v[1], v[2]), Eigen::Vector3d(v[3], v[4], v[5]));
     if (!surface.ok()) return fail("--plane '" + a.plane + "': " + surface.error());
   } else {

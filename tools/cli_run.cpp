@@ -26,6 +26,18 @@ int fail(const std::string& message) {
   return 1;
 }
 
+// A report path must name a file. Checked before a run, so that a long run does not end in
+// this error, and again before writing.
+Status checkReportPath(const std::string& path) {
+  if (path.empty()) return Status::Ok();
+  std::error_code ec;
+  if (!fs::path(path).has_filename() || fs::is_directory(path, ec)) {
+    return Error{"--report '" + path + "' names a folder; give a file, e.g. '" +
+                 (fs::path(path) / "report.json").lexically_normal().string() + "'"};
+  }
+  return Status::Ok();
+}
+
 // Frames into `folder` (PNG through the headless renderer); nothing when `folder` is empty.
 Status setUpFrames(const engine::Scene& scene, const std::string& folder,
                    std::unique_ptr<render::OffscreenRenderer>& renderer, engine::RunOptions& options) {
@@ -101,6 +113,7 @@ void printReport(const engine::RunReport& r, const std::string& frames, const st
 // Writes the report (when asked), prints it (unless quiet); the exit status of the run.
 int finishRun(const engine::RunReport& r, const std::string& frames, const std::string& report, bool quiet) {
   if (!report.empty()) {
+    if (Status st = checkReportPath(report); !st.ok()) return fail(st.error());
     if (Status st = writeFileAtomically(report, engine::reportJson(r)); !st.ok()) return fail(st.error());
   }
   if (!quiet) printReport(r, frames, report);
@@ -108,6 +121,7 @@ int finishRun(const engine::RunReport& r, const std::string& frames, const std::
 }
 
 int runCommand(const RunArgs& args) {
+  if (Status st = checkReportPath(args.report); !st.ok()) return fail(st.error());
   const std::string scene_path = args.scene.empty() ? tools::defaultScenePath() : args.scene;
   auto scene = engine::loadScene(scene_path);
   if (!scene.ok()) return fail(scene.error());
@@ -155,6 +169,7 @@ int runCommand(const RunArgs& args) {
 }
 
 int replayCommand(const ReplayArgs& args) {
+  if (Status st = checkReportPath(args.report); !st.ok()) return fail(st.error());
   auto recording = std::make_shared<haptics::Recording>();
   std::string error;
   if (!haptics::readRecording(args.recording, *recording, error)) return fail(error);
@@ -183,14 +198,14 @@ int replayCommand(const ReplayArgs& args) {
 // What run and replay write, and how much they say.
 void addOutputOptions(CLI::App& cmd, std::string& frames, int& every, std::string& report, bool& quiet) {
   cmd.add_option("--frames", frames, "Write PNG frames into this folder");
-  cmd.add_option("--every", every, "Render a frame every K steps (default: the scene's)")->check(CLI::PositiveNumber);
+  cmd.add_option("--every", every, "Render a frame every K steps (default: the scene's)")->check(finiteRange(1, 1e6));
   cmd.add_option("--report", report, "Write the JSON report to this file");
   cmd.add_flag("--quiet", quiet, "Print nothing but errors");
 }
 
 void addRunOptions(CLI::App& cmd, RunArgs& run) {
   cmd.add_option("scene", run.scene, "Scene file (default: scenes/default.yaml)")->check(CLI::ExistingFile);
-  cmd.add_option("--steps", run.steps, "Number of steps (default: the scene's)")->check(CLI::NonNegativeNumber);
+  cmd.add_option("--steps", run.steps, "Number of steps (default: the scene's)")->check(finiteRange(0, 1e8));
   addOutputOptions(cmd, run.frames, run.every, run.report, run.quiet);
   cmd.add_option("--chips", run.chips, "Override the scene's chips mode: remove or simulate")
       ->check(CLI::IsMember({"remove", "simulate"}));
@@ -210,7 +225,7 @@ void addRunOptions(CLI::App& cmd, RunArgs& run) {
                  "haptics/README.md)")
       ->check(CLI::ExistingFile);
   cmd.add_option("--device-wait-s", run.device_wait_s, "udp: seconds to wait for the bridge's first packet")
-      ->check(CLI::Range(0.0, 3600.0));
+      ->check(finiteRange(0.0, 3600.0));
   cmd.add_option("--gamepad-mapping", run.gamepad_mapping, "Game controller mapping file (haptics/README.md)")
       ->check(CLI::ExistingFile);
   cmd.add_flag("--realtime", run.realtime,

@@ -65,7 +65,13 @@ int main(int argc, char** argv) {
   auto cut2d_commands = hysim::tools::addCut2dCommands(app);  // hysim cut, hysim tables
   auto accuracy_command = hysim::tools::addAccuracyCommand(app);
 
-  CLI11_PARSE(app, argc, argv);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    // CLI11 prints the message; its exit codes differ by kind of error (105 for a failed
+    // check), and hysim's bad input is exit status 1 whatever the kind (README).
+    return app.exit(e) == 0 ? 0 : 1;
+  }
   if (auto rc = hysim::tools::runCut2dCommands(*cut2d_commands)) return *rc;
   if (auto rc = hysim::tools::runAccuracyCommand(*accuracy_command)) return *rc;
   if (auto rc = hysim::tools::runRunCommands(*run_commands)) return *rc;

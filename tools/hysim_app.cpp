@@ -444,9 +444,9 @@ int main(int argc, char** argv) {
   CLI::App app{"hysim-app: hysteroscopy training simulator window (SDL2 + ImGui)"};
   AppArgs args;
   app.add_option("scene", args.scene, "Scene file (default: scenes/default.yaml)")->check(CLI::ExistingFile);
-  app.add_option("--frames", args.frames, "Quit after N frames")->check(CLI::PositiveNumber);
+  app.add_option("--frames", args.frames, "Quit after N frames")->check(tools::finiteRange(1, 1e9));
   app.add_option("--quit-after-s", args.quit_after_s, "Quit after S seconds of wall time")
-      ->check(CLI::NonNegativeNumber);
+      ->check(tools::finiteRange(0, 1e6));
   app.add_option("--screenshot", args.screenshot, "Save the last window frame as PNG on exit");
   app.add_option("--width", args.width, "Window width")->check(CLI::Range(320, 16384));
   app.add_option("--height", args.height, "Window height")->check(CLI::Range(240, 16384));

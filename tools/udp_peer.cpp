@@ -135,11 +135,11 @@ int main(int argc, char** argv) {
   app.add_option("scene", args.scene, "scene file (default: scenes/default.yaml)");
   app.add_option("--port", args.port, "hysim's UDP device port")->required()->check(CLI::Range(1, 65535));
   app.add_option("--host", args.host, "hysim's IPv4 address")->capture_default_str();
-  app.add_option("--rate", args.rate_hz, "state packets per second")->capture_default_str()->check(CLI::Range(1.0, 10000.0));
-  app.add_option("--seconds", args.seconds, "how long to send (default: the path's duration)")->check(CLI::Range(0.0, 86400.0));
+  app.add_option("--rate", args.rate_hz, "state packets per second")->capture_default_str()->check(tools::finiteRange(1.0, 10000.0));
+  app.add_option("--seconds", args.seconds, "how long to send (default: the path's duration)")->check(tools::finiteRange(0.0, 86400.0));
   app.add_option("--start-delay-s", args.start_delay_s, "wait this long before the first packet")
       ->capture_default_str()
-      ->check(CLI::Range(0.0, 3600.0));
+      ->check(tools::finiteRange(0.0, 3600.0));
   CLI11_PARSE(app, argc, argv);
 
   auto scene = engine::loadScene(args.scene);

@@ -14,14 +14,37 @@
 
 namespace hysim::cutting {
 
+namespace {
+
+// `v` / |v| without overflow or underflow in |v|: the plain quotient where the norm is well
+// inside the double range (bit for bit what callers always got), else v is first scaled by
+// its largest component, so that a normal like (0, 0, 1e300) is still a direction.
+// Returns false for a zero or non-finite vector.
+bool safeNormalized(const Eigen::Vector3d& v, Eigen::Vector3d& out) {
+  if (!v.allFinite()) return false;
+  const double len = v.norm();
+  if (std::isfinite(len) && len > 1e-150) {
+    out = v / len;
+    return true;
+  }
+  const double largest = v.cwiseAbs().maxCoeff();
+  if (!(largest > 0)) return false;
+  const Eigen::Vector3d scaled = v / largest;
+  out = scaled / scaled.norm();
+  return true;
+}
+
+}  // namespace
+
 Result<CutSurface> CutSurface::plane(const Eigen::Vector3d& point, const Eigen::Vector3d& normal) {
   if (!point.allFinite() || !normal.allFinite()) return Error{"cut plane: non-finite point or normal"};
-  const double len = normal.norm();
-  if (!(len > 0)) return Error{"cut plane: zero normal"};
+  if (point.cwiseAbs().maxCoeff() > kMaxCoordinateMm) {
+    return Error{"cut plane: point coordinate beyond +-1e30 mm (larger values overflow distances)"};
+  }
   CutSurface s;
+  if (!safeNormalized(normal, s.normal_)) return Error{"cut plane: zero normal"};
   s.is_plane_ = true;
   s.point_ = point;
-  s.normal_ = normal / len;
   return s;
 }
 
@@ -39,6 +62,8 @@ Result<std::vector<CutSurface::Tri>> CutSurface::collect(const Positions& X, con
     t.c = X.row(F(f, 2)).transpose();
     if (!t.a.allFinite() || !t.b.allFinite() || !t.c.allFinite())
       return Error{"cut surface: triangle " + std::to_string(f) + " has non-finite coordinates"};
+    if (std::max({t.a.cwiseAbs().maxCoeff(), t.b.cwiseAbs().maxCoeff(), t.c.cwiseAbs().maxCoeff()}) > kMaxCoordinateMm)
+      return Error{"cut surface: triangle " + std::to_string(f) + " has a coordinate beyond +-1e30 mm"};
     const Eigen::Vector3d n = (t.b - t.a).cross(t.c - t.a);
     const double scale = std::max({(t.b - t.a).squaredNorm(), (t.c - t.a).squaredNorm(), (t.c - t.b).squaredNorm()});
     if (!(n.norm() > 1e-12 * scale)) continue;  // degenerate

@@ -20,6 +20,7 @@
 #include <string_view>
 #include <vector>
 
+#include "hysim/cutting/input_file.hpp"
 #include "mesh_io_detail.hpp"
 
 namespace hysim::cutting::io_detail {
@@ -82,6 +83,12 @@ std::string quoted(std::string_view s) {
   return out;
 }
 
+std::string coordinateTooLarge(std::string_view token) {
+  char bound[32];
+  std::snprintf(bound, sizeof bound, "%g", kMaxCoordinateMm);
+  return "coordinate " + quoted(token) + " beyond +-" + bound + " mm (larger values overflow volumes)";
+}
+
 std::size_t cappedReserve(long long count, std::size_t fileSize) {
   return static_cast<std::size_t>(std::clamp<long long>(count, 0, static_cast<long long>(fileSize / 2 + 1)));
 }
@@ -93,20 +100,6 @@ namespace hysim::cutting {
 namespace {
 
 using namespace io_detail;
-
-Result<std::string> readWholeFile(const std::string& path) {
-  std::FILE* file = std::fopen(path.c_str(), "rb");
-  if (!file) return Error{"cannot open '" + path + "': " + std::strerror(errno)};
-  std::string text;
-  char buffer[1 << 16];
-  std::size_t got = 0;
-  while ((got = std::fread(buffer, 1, sizeof buffer, file)) > 0) text.append(buffer, got);
-  const bool failed = std::ferror(file) != 0;
-  const int readErrno = errno;  // e.g. EISDIR: fopen succeeds on a directory, fread fails
-  std::fclose(file);
-  if (failed) return Error{"cannot read '" + path + "': " + std::strerror(readErrno)};
-  return text;
-}
 
 Status writeWholeFile(const std::string& path, const std::string& text) {
   std::FILE* file = std::fopen(path.c_str(), "wb");
@@ -144,7 +137,7 @@ Result<Format> formatForReading(const std::string& path, const std::string& text
 
 // Reads and parses a file; `format` receives the format it was read as.
 Result<RawMesh> readRaw(const std::string& path, Format& format) {
-  Result<std::string> text = readWholeFile(path);
+  Result<std::string> text = readInputFile(path, kMaxMeshFileBytes, "mesh");
   if (!text) return Error{text.error()};
   Result<Format> detected = formatForReading(path, *text);
   if (!detected) return Error{detected.error()};

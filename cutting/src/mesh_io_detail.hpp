@@ -6,6 +6,7 @@
 #include <string_view>
 #include <vector>
 
+#include "hysim/cutting/mesh.hpp"
 #include "hysim/cutting/result.hpp"
 
 namespace hysim::cutting::io_detail {
@@ -43,6 +44,9 @@ bool fitsInt32(long long v);
 // File text shown in a message: cut short and with control characters (a stray '\r', binary
 // bytes) replaced, so that a message stays one readable line.
 std::string quoted(std::string_view s);
+// "coordinate '<token>' beyond +-1e+30 mm ..." (kMaxCoordinateMm), for a coordinate the
+// readers refuse because products of such values overflow in volumes and quality measures.
+std::string coordinateTooLarge(std::string_view token);
 // Untrusted counts must not drive huge allocations: no element or node can take less
 // than two characters of the file.
 std::size_t cappedReserve(long long count, std::size_t fileSize);

@@ -45,6 +45,17 @@ class LineReader {
   long long lineNumber_ = 0;
 };
 
+// Nodes of each element type the MSH 2.2 format defines (Gmsh reference manual, "MSH file
+// format version 2"), or -1 for a number that is no MSH 2.2 element type.
+int mshNodesPerElement(long long type) {
+  static constexpr int kNodes[32] = {-1, 2,  3,  4,  4,  8,  6,  5,  3,  6,  9,  10, 27, 18, 14, 1,
+                                     8,  20, 15, 13, 9,  10, 12, 15, 15, 21, 4,  5,  6,  20, 35, 56};
+  if (type >= 1 && type <= 31) return kNodes[type];
+  if (type == 92) return 64;   // 64-node third-order hexahedron
+  if (type == 93) return 125;  // 125-node fourth-order hexahedron
+  return -1;
+}
+
 class MshParser {
  public:
   MshParser(const std::string& path, const std::string& text) : path_(path), text_(text), lines_(text) {}
@@ -161,6 +172,9 @@ class MshParser {
         if (!std::isfinite(value)) {
           return fail("non-finite coordinate " + quoted(token) + " for node " + std::to_string(id));
         }
+        if (std::abs(value) > kMaxCoordinateMm) {
+          return fail(coordinateTooLarge(token) + " for node " + std::to_string(id));
+        }
         mesh_.xyz.push_back(value);
       }
       if (!fitsInt32(i)) return fail("too many nodes for 32-bit indices");
@@ -215,16 +229,23 @@ class MshParser {
         }
         resolved_.push_back(found->second);
       }
+      // Every element's node count is checked against its type, also for the kinds that are
+      // ignored: a count that does not match means the line is misread.
+      const int expected = mshNodesPerElement(type);
+      if (expected < 0) {
+        return fail("element " + std::to_string(id) + " has unknown element type " + std::to_string(type) +
+                    " (MSH 2.2 defines types 1-31, 92 and 93)");
+      }
+      if (numNodes != static_cast<std::size_t>(expected)) {
+        const std::string kind =
+            type == 4 ? "tetrahedron" : type == 2 ? "triangle" : "element type " + std::to_string(type);
+        return fail("expected " + std::to_string(expected) + " node indices for " + kind + ", got " +
+                    std::to_string(numNodes));
+      }
       if (type == 4) {  // 4-node tetrahedron
-        if (numNodes != 4) {
-          return fail("expected 4 node indices for tetrahedron, got " + std::to_string(numNodes));
-        }
         mesh_.tets.insert(mesh_.tets.end(), resolved_.begin(), resolved_.end());
         mesh_.tetMaterial.push_back(static_cast<std::int32_t>(material));
       } else if (type == 2) {  // 3-node triangle
-        if (numNodes != 3) {
-          return fail("expected 3 node indices for triangle, got " + std::to_string(numNodes));
-        }
         mesh_.tris.insert(mesh_.tris.end(), resolved_.begin(), resolved_.end());
         mesh_.triMaterial.push_back(static_cast<std::int32_t>(material));
       }

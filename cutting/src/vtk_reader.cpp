@@ -79,6 +79,13 @@ class TokenReader {
   long long tokenLine_ = 1;
 };
 
+// The cell type ids VTK defines (vtkCellType.h): linear cells 0-16, quadratic and cubic
+// 21-37, convex point set and polyhedron 41-42, parametric 51-56, higher order 60-81.
+bool isVtkCellType(long long type) {
+  return (type >= 0 && type <= 16) || (type >= 21 && type <= 37) || type == 41 || type == 42 ||
+         (type >= 51 && type <= 56) || (type >= 60 && type <= 81);
+}
+
 class VtkParser {
  public:
   VtkParser(const std::string& path, const std::string& text) : path_(path), text_(text), tokens_(text) {}
@@ -130,6 +137,7 @@ class VtkParser {
     if (lowercase(magic).rfind("# vtk datafile version", 0) != 0) {
       return failAtToken("expected '# vtk DataFile Version x.y', got " + quoted(magic));
     }
+    if (Status s = checkVersion(magic); !s) return s;
     tokens_.restOfLine();  // title: free text
     const std::string_view format = trim(tokens_.restOfLine());
     if (lowercase(format) == "binary") {
@@ -142,6 +150,21 @@ class VtkParser {
     if (!tokens_.next(word)) return failAtEnd("expected dataset type");
     if (lowercase(word) != "unstructured_grid") {
       return failAtToken("unsupported dataset type " + quoted(word) + " (only UNSTRUCTURED_GRID)");
+    }
+    return Status::Ok();
+  }
+
+  // The legacy format's versions are 1.0 to 5.1; another number is another format, or a typo.
+  Status checkVersion(std::string_view magic) {
+    const std::string_view version = trim(magic.substr(std::string_view("# vtk DataFile Version").size()));
+    const std::size_t dot = version.find('.');
+    long long major = -1, minor = -1;
+    const bool parsed = dot != std::string_view::npos && parseInteger(version.substr(0, dot), major) &&
+                        parseInteger(version.substr(dot + 1), minor) && version.front() != '+' &&
+                        version[dot + 1] != '+' && minor >= 0;
+    if (!parsed || major < 1 || major > 5 || (major == 5 && minor > 1)) {
+      return failAtToken("unsupported VTK version " + quoted(version) +
+                         " (legacy VTK files are versions 1.0 to 5.1: '# vtk DataFile Version 3.0')");
     }
     return Status::Ok();
   }
@@ -202,6 +225,9 @@ class VtkParser {
         }
         if (!std::isfinite(value)) {
           return failAtToken("non-finite coordinate " + quoted(token) + " for point " + std::to_string(i));
+        }
+        if (std::abs(value) > kMaxCoordinateMm) {
+          return failAtToken(coordinateTooLarge(token) + " for point " + std::to_string(i));
         }
         mesh_.xyz.push_back(value);
       }
@@ -306,6 +332,7 @@ class VtkParser {
       long long type = 0;
       if (Status s = readInteger("type of cell", type, c); !s) return s;
       cellTypes_.push_back(type);
+      cellTypeLine_.push_back(tokens_.tokenLine());
     }
     return Status::Ok();
   }
@@ -492,6 +519,11 @@ class VtkParser {
         }
       }
       const long long type = cellTypes_[cell];
+      if (!isVtkCellType(type)) {
+        return errorAt(path_, cellTypeLine_[cell],
+                       "cell " + std::to_string(c) + " has unknown cell type " + std::to_string(type) +
+                           " (VTK cell types are 0-16, 21-37, 41, 42, 51-56 and 60-81)");
+      }
       const std::int32_t material = material_.empty() ? 0 : material_[cell];
       const auto first = connectivity_.begin() + begin;
       if (type == 10) {  // VTK_TETRA
@@ -527,6 +559,7 @@ class VtkParser {
   std::vector<long long> cellLine_;         // #cells: line where each cell starts (messages)
   std::vector<std::int32_t> connectivity_;  // point indices of all cells, concatenated
   std::vector<long long> cellTypes_;        // #cells VTK cell type ids
+  std::vector<long long> cellTypeLine_;     // #cells: line of each cell's type (messages)
   std::vector<std::int32_t> material_;      // #cells labels, or empty
   bool materialIsFinal_ = false;
   bool seenPoints_ = false, seenCells_ = false, seenCellTypes_ = false, seenAttributes_ = false;

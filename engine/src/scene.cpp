@@ -1,12 +1,13 @@
 #include "hysim/engine/scene.hpp"
 
+#include "hysim/cutting/input_file.hpp"
 #include "hysim/haptics/device.hpp"
 
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <set>
 #include <sstream>
 
@@ -14,6 +15,15 @@ namespace hysim::engine {
 namespace {
 
 namespace fs = std::filesystem;
+
+// Every number in a scene is a physical quantity in mm, g, s or kPa, or a count; none comes
+// near 1e9 (1000 km as a position), and products of a few values of at most 1e9 stay far
+// from overflow in the model.
+constexpr double kMaxSceneNumber = 1e9;
+// A walk over a document with aliases can revisit shared parts many times (a "billion laughs"
+// file); past this many nodes the scene is refused.
+constexpr long kMaxSceneNodes = 1000000;
+constexpr int kMaxSceneDepth = 64;
 
 // Thrown inside the parser only and turned into a Result at the boundary: the parser is a
 // deep recursive walk and an early exit from every level would hide its logic.
@@ -57,6 +67,9 @@ class Reader {
     double value = 0.0;
     if (!YAML::convert<double>::decode(n, value)) fail(n, "'" + key + "' must be a number, got '" + n.Scalar() + "'");
     if (!std::isfinite(value)) fail(n, "'" + key + "' must be finite, got '" + n.Scalar() + "'");
+    if (std::abs(value) > kMaxSceneNumber) {
+      fail(n, "'" + key + "' must be between -1e9 and 1e9, got '" + n.Scalar() + "'");
+    }
     return value;
   }
   double positive(const YAML::Node& n, const std::string& key) const {
@@ -97,7 +110,45 @@ class Reader {
     return v.normalized();
   }
 
+  // Before any value is read: no mapping holds a key twice (YAML parsers keep one of them
+  // silently) and every scalar, keys included, is UTF-8 (names and paths go into the JSON
+  // report, whose writer refuses anything else). `where` is the path of `n` for messages.
+  void checkDocument(const YAML::Node& n, const std::string& where, int depth, long& visited) const {
+    if (++visited > kMaxSceneNodes) {
+      fail(n, "the scene expands to more than " + std::to_string(kMaxSceneNodes) + " YAML nodes (aliases?)");
+    }
+    if (depth > kMaxSceneDepth) {
+      fail(n, "'" + where + "' is nested more than " + std::to_string(kMaxSceneDepth) + " levels deep");
+    }
+    if (n.IsScalar()) {
+      checkUtf8(n, "'" + where + "'");
+    } else if (n.IsSequence()) {
+      for (std::size_t i = 0; i < n.size(); ++i) {
+        checkDocument(n[i], where + "[" + std::to_string(i) + "]", depth + 1, visited);
+      }
+    } else if (n.IsMap()) {
+      std::set<std::string> seen;
+      for (const auto& kv : n) {
+        if (!kv.first.IsScalar()) fail(kv.first, "a key in '" + where + "' is not a plain name");
+        checkUtf8(kv.first, "a key in '" + where + "'");
+        const std::string key = kv.first.Scalar();
+        if (!seen.insert(key).second) fail(kv.first, "duplicate key '" + key + "' in '" + where + "'");
+        checkDocument(kv.second, where == "scene" ? key : where + "." + key, depth + 1, visited);
+      }
+    }
+  }
+
  private:
+  void checkUtf8(const YAML::Node& n, const std::string& what) const {
+    const std::string& text = n.Scalar();
+    const std::size_t bad = firstInvalidUtf8(text);
+    if (bad == std::string::npos) return;
+    char byte[8];
+    std::snprintf(byte, sizeof byte, "0x%02x", static_cast<unsigned>(static_cast<unsigned char>(text[bad])));
+    fail(n, what + " is not valid UTF-8: byte " + byte + " at offset " + std::to_string(bad) +
+                " of the value (save the file as UTF-8)");
+  }
+
   std::string file_;
 };
 
@@ -408,11 +459,13 @@ bool AnchorRegion::contains(const Eigen::Vector3d& p) const {
 }
 
 Result<Scene> loadScene(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) return Error{path + ": cannot open scene file"};
+  Result<std::string> text = readInputFile(path, kMaxYamlFileBytes, "scene");
+  if (!text.ok()) return Error{text.error()};
   const Reader reader(path);
   try {
-    const YAML::Node root = YAML::Load(in);
+    const YAML::Node root = YAML::Load(*text);
+    long visited = 0;
+    reader.checkDocument(root, "scene", 0, visited);
     return parse(reader, root, path);
   } catch (const SceneError& e) {
     return Error{e.message};

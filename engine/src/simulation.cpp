@@ -12,6 +12,7 @@
 #include <limits>
 
 #include "hysim/cutting/cut3d.hpp"
+#include "hysim/cutting/input_file.hpp"
 #include "hysim/engine/mesh_faces.hpp"
 #include "hysim/cutting/mesh_io.hpp"
 #include "hysim/cutting/mesh_stats.hpp"
@@ -56,6 +57,8 @@ Result<haptics::CouplingGains> couplingFor(const Scene& scene) {
 }  // namespace
 
 Result<render::SurfaceMesh> loadSurface(const std::string& path, render::SurfaceMaterial material) {
+  // assimp reads the file itself: refuse devices, FIFOs and huge files before it does.
+  if (Status s = checkInputFile(path, kMaxMeshFileBytes, "surface"); !s.ok()) return Error{s.error()};
   Assimp::Importer importer;
   const aiScene* scene = importer.ReadFile(
       path, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_PreTransformVertices);
@@ -70,6 +73,9 @@ Result<render::SurfaceMesh> loadSurface(const std::string& path, render::Surface
       const aiVector3D& p = mesh->mVertices[v];
       if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
         return Error{path + ": non-finite vertex " + std::to_string(v)};
+      }
+      if (std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z)}) > cutting::kMaxCoordinateMm) {
+        return Error{path + ": vertex " + std::to_string(v) + " has a coordinate beyond +-1e30 mm"};
       }
       out.positions.insert(out.positions.end(), {p.x, p.y, p.z});
       out.material.push_back(material);

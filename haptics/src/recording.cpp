@@ -9,6 +9,7 @@
 
 #include <unistd.h>
 
+#include "hysim/cutting/input_file.hpp"
 #include "hysim/haptics/little_endian.hpp"
 
 namespace hysim::haptics {
@@ -156,12 +157,15 @@ bool readRecords(Reader& r, Recording& out) {
   return true;
 }
 
+// Read whole into memory, so bounded: 4 GiB is over six hours of 180-byte records at 1 kHz.
+constexpr std::uintmax_t kMaxRecordingFileBytes = std::uintmax_t{4} << 30;
+
 bool readWholeFile(const std::string& path, std::vector<unsigned char>& bytes, std::string& error) {
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) {
-    error = path + ": not a regular file";
+  if (Status s = checkInputFile(path, kMaxRecordingFileBytes, "recording"); !s.ok()) {
+    error = s.error();
     return false;
   }
+  std::error_code ec;
   std::ifstream in(path, std::ios::binary);
   if (!in) {
     error = path + ": cannot open";
@@ -236,6 +240,12 @@ bool RecordingWriter::open(const std::string& path, const RecordingHeader& heade
       return false;
     }
   }
+  // A folder cannot take the file: said now, not at the rename after the whole run.
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec) || path.empty() || path.back() == '/') {
+    error = "cannot record into '" + path + "': it names a folder, not a file";
+    return false;
+  }
   path_ = path;
   const std::string tmp = path + ".tmp";
   file_ = std::fopen(tmp.c_str(), "wb");
@@ -291,6 +301,8 @@ bool RecordingWriter::finish(std::string& error) {
   std::filesystem::rename(tmp, path_, ec);
   if (ec) {
     error = "cannot move '" + tmp + "' to '" + path_ + "': " + ec.message();
+    std::error_code ignored;
+    std::filesystem::remove(tmp, ignored);  // nothing half-done is left behind
     return false;
   }
   return true;

@@ -61,7 +61,7 @@ void randomPlanes(const TetMesh& mesh, int planes, const Cut3DOptions& options, 
 
 TEST(Cut3DAcceptance, UterusRandomPlanesValidGrowthVolume) {
   const std::string path = std::string(HYSIM_SOURCE_DIR) + "/assets/uterus_myoma.msh";
-  if (!std::filesystem::exists(path)) GTEST_SKIP() << "no " << path;
+  ASSERT_TRUE(std::filesystem::exists(path)) << "missing " << path << ", an asset shipped in the repository";
   auto mesh = readTetMesh(path);
   ASSERT_TRUE(mesh.ok()) << mesh.error();
   double q = 0, e = 0, dev = 0;
@@ -78,7 +78,7 @@ TEST(Cut3DAcceptance, UterusRandomPlanesValidGrowthVolume) {
 // Without feature sliding (corners and bent ridges stay where they are; on by default).
 TEST(Cut3DAcceptance, UterusRandomPlanesNoFeatureSlide) {
   const std::string path = std::string(HYSIM_SOURCE_DIR) + "/assets/uterus_myoma.msh";
-  if (!std::filesystem::exists(path)) GTEST_SKIP() << "no " << path;
+  ASSERT_TRUE(std::filesystem::exists(path)) << "missing " << path << ", an asset shipped in the repository";
   auto mesh = readTetMesh(path);
   ASSERT_TRUE(mesh.ok()) << mesh.error();
   Cut3DOptions o;
@@ -98,7 +98,7 @@ TEST(Cut3DAcceptance, UterusRandomPlanesNoFeatureSlide) {
 // worst over 100 planes with seeds 7 / 11; routed nodes <= 0.41 mm off the plane).
 TEST(Cut3DAcceptance, UterusRandomPlanesRoutingAndFeatureSlide) {
   const std::string path = std::string(HYSIM_SOURCE_DIR) + "/assets/uterus_myoma.msh";
-  if (!std::filesystem::exists(path)) GTEST_SKIP() << "no " << path;
+  ASSERT_TRUE(std::filesystem::exists(path)) << "missing " << path << ", an asset shipped in the repository";
   auto mesh = readTetMesh(path);
   ASSERT_TRUE(mesh.ok()) << mesh.error();
   Cut3DOptions o;

@@ -2,7 +2,6 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
-#include <chrono>
 #include <cmath>
 #include <limits>
 #include <set>
@@ -233,17 +232,13 @@ TEST(ValidateTet, UnusedNodesOnlyWhenRequired) {
   EXPECT_EQ(s.error(), "node 4: not used by any element");
 }
 
-// validate() runs after every cut on 20k-tet meshes in tests: it must stay O(n log n).
-TEST(ValidateTet, FastOnTwentyThousandTets) {
+// validate() runs after every cut on 20k-tet meshes in tests. Its cost is measured by
+// bench_cut3d (BM_ValidateTetMesh), not bounded here: a wall-clock bound fails on a busy machine.
+TEST(ValidateTet, AcceptsTwentyThousandTets) {
   const TetMesh box = testing::boxTetMesh(16, 16, 13, 0.25);
   ASSERT_EQ(box.numTets(), 19968);
-  const auto start = std::chrono::steady_clock::now();
   const Status s = validate(box, {.requireAllNodesUsed = true});
-  const double ms =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   EXPECT_TRUE(s.ok()) << s.error();
-  // Typically a few ms; the bound is loose because CI machines are shared.
-  EXPECT_LT(ms, 250.0);
 }
 
 // --- validate(TriMesh) -----------------------------------------------------------------

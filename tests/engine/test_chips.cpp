@@ -344,9 +344,9 @@ TEST(Chips, StepWithAChipAllocatesNothingInSteadyState) {
   EXPECT_EQ(count, 0);
 }
 
-// Cost of a Bullet step with 16 chips resting on a triangle-mesh floor (printed; the bound
-// is loose, a regression guard only).
-TEST(Chips, StepCostWith16Chips) {
+// A Bullet world with 16 chips resting on a triangle-mesh floor keeps them all; the cost of
+// a step is printed and recorded, not bounded (a wall-clock bound fails on a busy machine).
+TEST(Chips, SixteenChipsRestOnAFloor) {
   ChipSettings settings;
   settings.mode = ChipSettings::Mode::Simulate;
   ChipWorld world(settings, Eigen::Vector3d(0, 0, -9810), 1e-3, toolFarAway());
@@ -367,7 +367,6 @@ TEST(Chips, StepCostWith16Chips) {
   std::printf("Bullet step, 16 chips: %.1f us while sinking, %.1f us at rest\n", falling_us, resting_us);
   RecordProperty("falling_us", std::to_string(falling_us));
   RecordProperty("resting_us", std::to_string(resting_us));
-  EXPECT_LT(falling_us, 2000.0);
   EXPECT_EQ(world.numChips(), 16);
 }
 

@@ -263,6 +263,13 @@ TEST(Recording, NotARegularFileIsRefusedBeforeReading) {
   EXPECT_NE(error.find("not a regular file"), std::string::npos) << error;
   EXPECT_FALSE(readRecording(testing::testDir("Recording").string(), rec, error));
   EXPECT_FALSE(readRecording("/nonexistent.hyrec", rec, error));
+  // Read whole into memory, so refused unread past 4 GiB (a sparse file: no disk used).
+  const std::string huge = (testing::testDir("Recording") / "huge.hyrec").string();
+  std::ofstream(huge).put('x');
+  std::filesystem::resize_file(huge, (std::uintmax_t{4} << 30) + 1);
+  EXPECT_FALSE(readRecording(huge, rec, error));
+  EXPECT_EQ(error, "cannot read '" + huge + "': 4294967297 bytes, more than the 4 GiB limit for a recording file");
+  std::filesystem::remove(huge);
 }
 
 TEST(ReplayDevice, GivesTheRecordedStatesInOrderThenHoldsTheLast) {

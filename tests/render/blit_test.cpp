@@ -10,6 +10,7 @@
 
 #include "hysim/render/demo_scene.hpp"
 #include "hysim/render/renderer.hpp"
+#include "require_gl.hpp"
 
 namespace hr = hysim::render;
 
@@ -70,7 +71,9 @@ class BlitTest : public ::testing::Test {
  protected:
   void SetUp() override {
     auto created = hr::OffscreenRenderer::create(160, 120);
-    if (!created.ok()) GTEST_SKIP() << "no headless EGL/GL here: " << created.error();
+    if (!created.ok()) {
+      HYSIM_SKIP_OR_FAIL_WITHOUT_GL("no headless EGL/GL here: " << created.error());
+    }
     r_ = std::move(*created);
     ASSERT_TRUE(r_->context().makeCurrent().ok());
   }

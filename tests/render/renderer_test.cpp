@@ -1,5 +1,6 @@
 // Off-screen rendering through EGL: golden image, mask, lighting, materials, robustness.
-// Skips (with the reason) only where no headless EGL display exists at all.
+// Skips (with the reason) only where no headless EGL display exists at all, and fails
+// instead where HYSIM_REQUIRE_GL=1.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -13,6 +14,7 @@
 
 #include "hysim/render/demo_scene.hpp"
 #include "hysim/render/renderer.hpp"
+#include "require_gl.hpp"
 
 namespace hr = hysim::render;
 namespace fs = std::filesystem;
@@ -106,7 +108,9 @@ class RenderTest : public ::testing::Test {
 
 #define GET_RENDERER_OR_SKIP(var, w, h)                                          \
   hr::OffscreenRenderer* var = renderer(w, h);                                   \
-  if (var == nullptr) GTEST_SKIP() << "no headless EGL/GL here: " << last_error_
+  if (var == nullptr) {                                                          \
+    HYSIM_SKIP_OR_FAIL_WITHOUT_GL("no headless EGL/GL here: " << last_error_);  \
+  }
 
 }  // namespace
 

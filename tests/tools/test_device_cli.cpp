@@ -68,6 +68,14 @@ TEST(DeviceCli, BadDeviceArgumentsAreClearErrors) {
   o = runHysim("run --steps 10 --device udp:39872 --device-filters " + dir + "/filters.yaml");
   EXPECT_EQ(o.exit_code, 1);
   EXPECT_NE(o.text.find("filters.yaml:3: 'max_sped_mm_s': unknown key"), std::string::npos) << o.text;
+  std::ofstream(dir + "/filters.yaml") << "scale: 0.5\nscale: 2\n";  // which one? neither
+  o = runHysim("run --steps 10 --device udp:39872 --device-filters " + dir + "/filters.yaml");
+  EXPECT_EQ(o.exit_code, 1);
+  EXPECT_NE(o.text.find("filters.yaml:2: duplicate key 'scale'"), std::string::npos) << o.text;
+  std::ofstream(dir + "/dup.yaml") << "- {t_s: 0.2, right_y: 1.0, right_y: 0.5}\n";
+  o = runHysim("run --steps 10 --device virtual-pad:" + dir + "/dup.yaml");
+  EXPECT_EQ(o.exit_code, 1);
+  EXPECT_NE(o.text.find("dup.yaml:1: duplicate key 'right_y'"), std::string::npos) << o.text;
   std::ofstream(dir + "/filters.yaml") << "scale: 0\n";
   o = runHysim("run --steps 10 --device udp:39872 --device-filters " + dir + "/filters.yaml");
   EXPECT_NE(o.text.find("filters.yaml:1: 'scale': 0 is outside"), std::string::npos) << o.text;

@@ -14,16 +14,23 @@ namespace {
 using nlohmann::json;
 namespace fs = std::filesystem;
 
+// Through a temporary file and a rename; on any failure the temporary file is removed.
 Status writeAtomically(const fs::path& path, const std::string& text) {
   const fs::path tmp = path.string() + ".tmp";
-  {
-    std::ofstream out(tmp);
-    out << text;
-    if (!out) return Error{tmp.string() + ": cannot write"};
-  }
   std::error_code ec;
-  fs::rename(tmp, path, ec);
-  if (ec) return Error{path.string() + ": cannot rename the temporary file (" + ec.message() + ")"};
+  if (fs::is_directory(path, ec)) return Error{path.string() + ": is a folder, cannot write the file there"};
+  bool written = false;
+  {
+    std::ofstream out(tmp, std::ios::binary);
+    out << text;
+    written = static_cast<bool>(out.flush());
+  }
+  if (written) fs::rename(tmp, path, ec);
+  if (!written || ec) {
+    std::error_code ignored;
+    fs::remove(tmp, ignored);
+    return Error{path.string() + (written ? ": cannot rename the temporary file (" + ec.message() + ")" : ": cannot write")};
+  }
   return {};
 }
 
@@ -237,7 +244,9 @@ std::string machineDescription() {
 
 Status writeStudyReport(const json& report, const std::string& dir, const std::string& gnuplot) {
   const fs::path d(dir);
-  if (Status s = writeAtomically(d / "report.json", report.dump(2) + "\n"); !s.ok()) return s;
+  // Scene and mesh paths may hold bytes that are not UTF-8: replaced, not fatal.
+  const std::string text = report.dump(2, ' ', false, json::error_handler_t::replace) + "\n";
+  if (Status s = writeAtomically(d / "report.json", text); !s.ok()) return s;
   const std::vector<std::string> plots = makePlots(report, d, gnuplot);
   return writeAtomically(d / "report.md", markdown(report, plots));
 }

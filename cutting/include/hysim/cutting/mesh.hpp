@@ -19,6 +19,12 @@ using Tets = Eigen::Matrix<std::int32_t, Eigen::Dynamic, 4>;     // #T x 4 node 
 using Tris = Eigen::Matrix<std::int32_t, Eigen::Dynamic, 3>;     // #F x 3 node indices
 using Labels = Eigen::Matrix<std::int32_t, Eigen::Dynamic, 1>;   // #E material label per element
 
+// Largest coordinate magnitude a mesh or cut surface may hold: 1e30 mm. The tet quality
+// measure multiplies up to eight edge lengths, so coordinates near the top of the double
+// range would make volumes and q overflow to inf or NaN; within +-1e30 those products stay
+// below 1e250, far from the double maximum 1.8e308. Readers refuse larger values.
+inline constexpr double kMaxCoordinateMm = 1e30;
+
 // Tetrahedral mesh. Positive orientation: (x1-x0) . ((x2-x0) x (x3-x0)) > 0.
 struct TetMesh {
   Positions X;       // #N x 3 node positions (mm)

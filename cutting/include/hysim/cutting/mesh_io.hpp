@@ -8,8 +8,11 @@
 
 namespace hysim::cutting {
 
-// Reads a tet mesh: the file's tetrahedra (MSH type 4 / VTK cell type 10). Other elements
-// are ignored. Unused nodes are kept. Fails on a file without tetrahedra.
+// Reads a tet mesh: the file's tetrahedra (MSH type 4 / VTK cell type 10). Other element
+// types of the format are ignored (in MSH files their node counts are checked); a type the
+// format does not define is an error. Unused nodes are kept. Fails on a file without
+// tetrahedra. The file must be a regular file of at most kMaxMeshFileBytes (input_file.hpp),
+// with coordinates within +-kMaxCoordinateMm; VTK files must be legacy versions 1.0 to 5.1.
 Result<TetMesh> readTetMesh(const std::string& path);
 // Reads a triangle mesh: the file's triangles (MSH type 2 / VTK cell type 5).
 Result<TriMesh> readTriMesh(const std::string& path);

@@ -4,9 +4,10 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <sstream>
 #include <string_view>
+
+#include "hysim/cutting/input_file.hpp"
 
 namespace hysim::haptics {
 
@@ -306,11 +307,9 @@ Result<GamepadMapping> parseGamepadMapping(const std::string& yaml_text, const s
 }
 
 Result<GamepadMapping> loadGamepadMapping(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) return Error{path + ": cannot open the gamepad mapping file"};
-  std::ostringstream text;
-  text << in.rdbuf();
-  return parseGamepadMapping(text.str(), path);
+  Result<std::string> text = readInputFile(path, kMaxYamlFileBytes, "gamepad mapping");
+  if (!text.ok()) return Error{text.error()};
+  return parseGamepadMapping(*text, path);
 }
 
 }  // namespace hysim::haptics
