@@ -1,5 +1,8 @@
 #include "cli_run.hpp"
 
+#include <signal.h>
+
+#include <atomic>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -14,12 +17,28 @@
 #include "hysim/haptics/recording.hpp"
 #include "hysim/render/renderer.hpp"
 #include "run_device.hpp"
+#include "run_session.hpp"
 #include "tool_common.hpp"
 
 namespace fs = std::filesystem;
 
 namespace hysim::tools {
 namespace {
+
+// Set by SIGINT and SIGTERM: the run stops before its next step and writes a partial report
+// (a lock-free atomic store is all a signal handler may do here).
+std::atomic<bool> g_stop_requested{false};
+
+extern "C" void requestStop(int) { g_stop_requested.store(true); }
+
+void stopOnInterrupt(engine::RunOptions& options) {
+  struct sigaction action {};
+  action.sa_handler = requestStop;
+  sigemptyset(&action.sa_mask);
+  sigaction(SIGINT, &action, nullptr);
+  sigaction(SIGTERM, &action, nullptr);
+  options.stop = &g_stop_requested;
+}
 
 int fail(const std::string& message) {
   std::cerr << "hysim: " << message << "\n";
@@ -117,6 +136,10 @@ int finishRun(const engine::RunReport& r, const std::string& frames, const std::
     if (Status st = writeFileAtomically(report, engine::reportJson(r)); !st.ok()) return fail(st.error());
   }
   if (!quiet) printReport(r, frames, report);
+  if (r.partial) {
+    std::fprintf(stderr, "hysim: stopped by a signal after %d steps; the report is partial\n", r.steps);
+    return 4;
+  }
   return r.warnings == 0 ? 0 : 3;
 }
 
@@ -141,6 +164,7 @@ int runCommand(const RunArgs& args) {
   options.every = args.every;
   options.realtime = args.realtime;
   options.before_step = [&device](engine::Simulation& s, int) { device.beforeStep(s); };
+  stopOnInterrupt(options);
   if (Status st = setUpFrames(*scene, args.frames, renderer, options); !st.ok()) return fail(st.error());
   haptics::RecordingWriter recorder;
   if (!args.record.empty()) {
@@ -153,12 +177,21 @@ int runCommand(const RunArgs& args) {
       return fail(st.error());
     }
   }
+  RunSession session;
+  if (!args.trainee.empty()) {
+    const std::string mode = args.device.empty() || args.device == "scripted" ? "demo" : "hands-on";
+    if (Status st = beginRunSession(args.data_dir, args.trainee, mode, *scene, args.record, session); !st.ok()) {
+      recorder.discard();
+      return fail(st.error());
+    }
+  }
   if (!args.quiet) printModel(*scene, **sim);
   auto report = engine::run(**sim, options);
   if (!report.ok()) {
     recorder.discard();
     return fail(report.error());
   }
+  finishRunSession(*report, session);
   if (recorder.isOpen()) {
     std::string error;
     if (!recorder.finish(error)) return fail(error);
@@ -180,6 +213,7 @@ int replayCommand(const ReplayArgs& args) {
   std::unique_ptr<render::OffscreenRenderer> renderer;
   engine::RunOptions options;
   options.every = args.every;
+  stopOnInterrupt(options);
   if (Status st = setUpFrames(scene->scene, args.frames, renderer, options); !st.ok()) return fail(st.error());
   if (!args.quiet) printModel(scene->scene, **sim);
   auto report = engine::replay(**sim, recording, options);
@@ -228,6 +262,10 @@ void addRunOptions(CLI::App& cmd, RunArgs& run) {
       ->check(finiteRange(0.0, 3600.0));
   cmd.add_option("--gamepad-mapping", run.gamepad_mapping, "Game controller mapping file (haptics/README.md)")
       ->check(CLI::ExistingFile);
+  cmd.add_option("--trainee", run.trainee,
+                 "Store the run as this trainee's session (hysim sessions list; a killed run shows as incomplete)");
+  cmd.add_option("--data-dir", run.data_dir,
+                 "The sessions' data folder (default: $HYSIM_DATA_DIR, $XDG_DATA_HOME/hysim or ~/.local/share/hysim)");
   cmd.add_flag("--realtime", run.realtime,
                "Pace the steps to the wall clock, with the haptic thread (1 kHz) rendering forces on a simulated "
                "device; the state sequence is the same as without");

@@ -26,6 +26,8 @@ struct RunArgs {
   std::string gamepad_mapping;
   std::string device_filters;   // udp: scale, transform and motion limit (YAML)
   double device_wait_s = 10.0;  // udp: how long to wait for the bridge's first packet
+  std::string trainee;   // store the run as this trainee's session (run_session.hpp)
+  std::string data_dir;  // the sessions' data folder; empty: the default
 };
 
 struct ReplayArgs {

@@ -13,6 +13,7 @@
 #include "cli_accuracy.hpp"
 #include "cli_cut2d.hpp"
 #include "cli_run.hpp"
+#include "cli_sessions.hpp"
 
 using namespace hysim;
 
@@ -64,6 +65,7 @@ int main(int argc, char** argv) {
 
   auto cut2d_commands = hysim::tools::addCut2dCommands(app);  // hysim cut, hysim tables
   auto accuracy_command = hysim::tools::addAccuracyCommand(app);
+  auto sessions_commands = hysim::tools::addSessionsCommands(app);  // hysim sessions list|export
 
   try {
     app.parse(argc, argv);
@@ -75,6 +77,7 @@ int main(int argc, char** argv) {
   if (auto rc = hysim::tools::runCut2dCommands(*cut2d_commands)) return *rc;
   if (auto rc = hysim::tools::runAccuracyCommand(*accuracy_command)) return *rc;
   if (auto rc = hysim::tools::runRunCommands(*run_commands)) return *rc;
+  if (auto rc = hysim::tools::runSessionsCommands(*sessions_commands)) return *rc;
   if (*stats_cmd) return statsCommand(stats_path, stats_json);
   return 1;
 }

@@ -81,6 +81,7 @@ std::string reportJson(const RunReport& r) {
   j["scene"] = r.scene;
   j["integrator"] = r.integrator;
   j["steps"] = r.steps;
+  j["partial"] = r.partial;
   j["dt"] = r.dt;
   j["nodes"] = r.nodes;
   j["elements"] = r.elements;

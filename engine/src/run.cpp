@@ -139,6 +139,11 @@ Result<RunReport> run(Simulation& sim, const RunOptions& options) {
   const std::int64_t start_ns = pace.nowNs();
   if (Status st = frame(); !st.ok()) return Error{st.error()};
   for (int i = 0; i < r.steps; ++i) {
+    if (options.stop != nullptr && options.stop->load(std::memory_order_relaxed)) {
+      r.steps = i;
+      r.partial = true;
+      break;
+    }
     if (haptic) {  // step i starts at start + i dt: absolute sleeps do not drift
       const std::int64_t due = start_ns + static_cast<std::int64_t>(i) * dt_ns;
       pace.sleepUntilNs(due);

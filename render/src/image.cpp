@@ -5,6 +5,7 @@
 #include <png.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <cstdlib>
 
 namespace hysim::render {
@@ -22,12 +23,18 @@ hysim::Status writePng(const std::string& path, const Image& image) {
   png.height = static_cast<png_uint_32>(image.height);
   png.format = PNG_FORMAT_RGBA;
   png.flags = PNG_IMAGE_FLAG_FAST;  // frames are written every k steps: favour speed over size
-  const int ok = png_image_write_to_file(&png, path.c_str(), 0, image.rgba.data(),
-                                         image.width * 4, nullptr);
+  // Through a temporary file and a rename: a run killed mid-write leaves no truncated frame.
+  const std::string tmp = path + ".tmp";
+  const int ok = png_image_write_to_file(&png, tmp.c_str(), 0, image.rgba.data(), image.width * 4, nullptr);
   if (!ok) {
     std::string message = path + ": cannot write PNG: " + png.message;
     png_image_free(&png);
+    std::remove(tmp.c_str());
     return hysim::Error{message};
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+    std::remove(tmp.c_str());
+    return hysim::Error{path + ": cannot write PNG: cannot move it from '" + tmp + "'"};
   }
   return hysim::Status::Ok();
 }

@@ -3,6 +3,7 @@
 // frame callback every k steps, and measures. As fast as possible, or (realtime) paced to
 // the wall clock with the haptic thread rendering the published local force model on a
 // simulated device; the state sequence is the same either way.
+#include <atomic>
 #include <cstdint>
 #include <functional>
 #include <string>
@@ -23,6 +24,9 @@ struct RunOptions {
   bool realtime = false;
   // Called before each step (step counts from 0): a replay attaches recorded devices here.
   std::function<void(Simulation&, int step)> before_step;
+  // Checked before each step: when it becomes true (e.g. on SIGINT) the run stops there and
+  // the report covers the steps done, marked partial.
+  const std::atomic<bool>* stop = nullptr;
 };
 
 // Median, 99th percentile and maximum of a set of samples (0 when empty).
@@ -36,7 +40,8 @@ struct RunReport {
   std::string scene;
   AssessmentSettings assessment_settings;  // the scene's
   std::string integrator;
-  int steps = 0;
+  int steps = 0;               // the steps done (fewer than asked when partial)
+  bool partial = false;        // stopped early (RunOptions::stop)
   double dt = 0.0;             // s
   int nodes = 0, elements = 0, deformable_elements = 0, springs = 0, anchored = 0;
   int substeps = 1;
