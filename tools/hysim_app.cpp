@@ -29,7 +29,9 @@
 #include "app_keys.hpp"
 #include "app_monitor.hpp"
 #include "app_pivot_scope.hpp"
+#include "app_panel.hpp"
 #include "app_recording.hpp"
+#include "app_session.hpp"
 #include "app_session_log.hpp"
 #include "tool_common.hpp"
 #include "hysim/engine/scene.hpp"
@@ -122,16 +124,6 @@ struct Pacer {
   void reset() { accumulator = behind_s = 0.0; }
 };
 
-struct Panel {
-  bool paused = false;
-  bool reset_requested = false;
-  int lens_index = 2;  // 0, 12, 30 degrees
-  float speed = 1.0f;
-  bool manual = false;  // keyboard drives the scope instead of the scripted path
-  bool manual_requested = false;
-  bool details = false;  // developer numbers (step time, substeps, forces) shown
-};
-
 // The trainee's keys held now (see app_keys.hpp for what each does).
 tools::TraineeKeys heldKeys() {
   const Uint8* k = SDL_GetKeyboardState(nullptr);
@@ -151,18 +143,8 @@ tools::TraineeKeys heldKeys() {
   return keys;
 }
 
-constexpr std::array<int, 3> kLens = {0, 12, 30};
-
-int lensIndexFor(double deg) {
-  int best = 0;
-  for (int i = 1; i < 3; ++i) {
-    if (std::fabs(kLens[i] - deg) < std::fabs(kLens[best] - deg)) best = i;
-  }
-  return best;
-}
-
 // A key the panel did not take. True: quit.
-bool handleKey(SDL_Keycode key, Panel& panel, tools::AppHaptics& force_feedback) {
+bool handleKey(SDL_Keycode key, tools::Panel& panel, tools::AppHaptics& force_feedback) {
   switch (key) {
     case SDLK_ESCAPE: return true;
     case SDLK_SPACE: panel.paused = !panel.paused; break;
@@ -201,42 +183,10 @@ bool stepDue(engine::Simulation& sim, tools::SessionMonitor& monitor, Pacer& pac
   return false;
 }
 
-// The panel's controls: pause, reset, speed, lens, manual scope, details, and the keys.
-void drawControls(Panel& panel) {
-  if (ImGui::Button(panel.paused ? "Resume (Space)" : "Pause (Space)", ImVec2(-1, 0))) {
-    panel.paused = !panel.paused;
-  }
-  if (ImGui::Button("Reset (R)", ImVec2(-1, 0))) panel.reset_requested = true;
-  ImGui::SliderFloat("speed", &panel.speed, 0.05f, 1.0f, "%.2fx");
-  ImGui::Text("lens (L)");
-  for (int i = 0; i < 3; ++i) {
-    char label[16];
-    std::snprintf(label, sizeof(label), "%d deg", kLens[i]);
-    if (i > 0) ImGui::SameLine();
-    ImGui::RadioButton(label, &panel.lens_index, i);
-  }
-  ImGui::Separator();
-  if (ImGui::Checkbox("manual scope (M)", &panel.manual)) {
-    panel.manual = !panel.manual;  // applied (and toggled) at the top of the next frame
-    panel.manual_requested = true;
-  }
-  if (panel.manual) {
-    ImGui::TextDisabled("W/S insert/withdraw");
-    ImGui::TextDisabled("arrows: pivot at the cervix");
-    ImGui::TextDisabled("A/D roll (lens view), Q/E loop in/out");
-    ImGui::TextDisabled("hold C or Left-Shift: CUT");
-  } else {
-    ImGui::TextDisabled("scope follows the scene's scripted path");
-  }
-  ImGui::Checkbox("details (I)", &panel.details);
-  ImGui::TextDisabled("X: force e-stop, F: reset force");
-  ImGui::TextDisabled("Esc: quit");
-}
-
 // Manual control: the game controller (when one is used) or else the keyboard scope, pivoting
 // at the cervix, takes over from the device's current pose (M toggles); back to the script
 // otherwise. Returns the keyboard scope (owned by the simulation) or null.
-haptics::PivotScopeDevice* toggleManual(engine::Simulation& sim, const engine::Scene& scene, Panel& panel,
+haptics::PivotScopeDevice* toggleManual(engine::Simulation& sim, const engine::Scene& scene, tools::Panel& panel,
                                         tools::AppGamepad& gamepad) {
   panel.manual_requested = false;
   panel.manual = !panel.manual;
@@ -268,121 +218,6 @@ tools::ViewRect blitView(render::SdlWindow& window, render::Renderer& renderer, 
   return {ImVec2(vx / scale, vy / scale), ImVec2((vx + vw) / scale, (vy + vh) / scale)};
 }
 
-// The numbers of the frame the panel shows.
-struct FrameNumbers {
-  double step_median_us = 0.0;
-  double realtime = 0.0;
-  double frame_ms = 0.0;
-  double behind_s = 0.0;
-  double tool_force_n = 0.0;
-  double max_force_n = 0.0;
-};
-
-// The developer's numbers, shown with "details": step time, substeps, pacing, forces,
-// numerical warnings, the force-feedback thread.
-void drawDetails(const engine::Scene& scene, const engine::Simulation& sim, const FrameNumbers& n,
-                 tools::AppHaptics& force_feedback) {
-  const sim::State& st = sim.state();
-  ImGui::Text("sim time     %8.3f s", st.time);
-  ImGui::Text("steps        %8llu  (dt %.3g ms)", static_cast<unsigned long long>(st.steps), 1e3 * scene.sim.dt);
-  ImGui::Text("step time    %8.1f us  (median of %d)", n.step_median_us, StepTimes::kWindow);
-  ImGui::Text("substeps     %8d", sim.model().substeps);
-  ImGui::Text("real time    %8.2f x", n.realtime);
-  ImGui::Text("frame        %8.1f ms", n.frame_ms);
-  if (n.behind_s > 0.05) {
-    // The simulation is never skipped ahead: a too slow machine runs in slow motion.
-    ImGui::TextColored(ImVec4(1.0f, 0.75f, 0.3f, 1.0f), "behind real time by %.2f s", n.behind_s);
-  }
-  ImGui::Text("tool force   %8.3f N", n.tool_force_n);
-  ImGui::Text("max force    %8.3f N", n.max_force_n);
-  force_feedback.drawPanel();
-  if (st.warnings > 0) {
-    ImGui::TextColored(ImVec4(1.0f, 0.35f, 0.3f, 1.0f), "numerical warnings %d", st.warnings);
-  } else {
-    ImGui::Text("numerical warnings %d", st.warnings);
-  }
-}
-
-// The panel: the case, the trainee's guidance, the controller, the controls, and the details.
-void drawPanel(const engine::Scene& scene, const engine::Simulation& sim, Panel& panel, const FrameNumbers& n,
-               const tools::GuidanceView& guidance, tools::AppHaptics& force_feedback,
-               const tools::AppGamepad& gamepad, const tools::AppRecording& recording, double path_end_s,
-               float panel_w, float panel_h) {
-  ImGui::SetNextWindowPos(ImVec2(0, 0));
-  ImGui::SetNextWindowSize(ImVec2(panel_w, panel_h));
-  ImGui::Begin("hysim", nullptr,
-               ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse);
-  ImGui::TextWrapped("%s", scene.description.empty() ? scene.name.c_str() : scene.description.c_str());
-  if (panel.paused) ImGui::TextColored(ImVec4(0.4f, 0.8f, 1.0f, 1.0f), "PAUSED");
-  ImGui::Separator();
-  tools::drawGuidance(guidance);
-  ImGui::Separator();
-  const char* path = gamepad.active()              ? "game controller"
-                     : panel.manual                ? "keyboard"
-                     : sim.state().time < path_end_s ? "scripted demo"
-                                                     : "demo done (holding last pose)";
-  ImGui::Text("scope        %s", path);
-  if (gamepad.active()) gamepad.drawPanel();
-  recording.drawPanel();
-  ImGui::Separator();
-  drawControls(panel);
-  if (panel.details) {
-    ImGui::Separator();
-    drawDetails(scene, sim, n, force_feedback);
-  }
-  ImGui::End();
-}
-
-// One session: a simulation from the scene, its recording and event log, the monitor that
-// raises the alarm. A reset ends it and starts the next.
-struct Session {
-  std::unique_ptr<engine::Simulation> sim;
-  tools::AppRecording recording;
-  tools::SessionLog log;
-  std::unique_ptr<tools::SessionMonitor> monitor;
-  haptics::PivotScopeDevice* scope = nullptr;  // the keyboard scope, owned by sim while in use
-};
-
-Status startSession(Session& s, const engine::Scene& scene, const std::string& record_path) {
-  auto created = engine::Simulation::create(scene);
-  if (!created.ok()) return Error{created.error()};
-  s.sim = std::move(created.value());
-  s.scope = nullptr;
-  s.recording.start(scene, *s.sim, record_path);
-  if (!s.recording.path().empty() && !s.log.open(tools::sessionLogPath(s.recording.path()))) {
-    std::printf("hysim-app: %s\n", s.log.problem().c_str());
-  }
-  s.monitor = std::make_unique<tools::SessionMonitor>(&s.log);
-  s.log.write(0.0, "session_start", {{"scene", scene.name}, {"recording", s.recording.path()}});
-  return Status::Ok();
-}
-
-void endSession(Session& s) {
-  if (!s.sim) return;
-  const tools::GuidanceNumbers g = tools::guidanceNumbers(*s.sim);
-  s.log.write(s.sim->state().time, "session_end",
-              {{"myoma_resected_pct", g.myoma_resected_pct}, {"healthy_removed_mm3", g.healthy_removed_mm3},
-               {"electrode_active_s", g.electrode_active_s}, {"chips", g.chips}, {"passes", g.passes},
-               {"perforations", g.perforations}, {"alarms", s.monitor->alarm().raised()}});
-  s.log.close();
-  s.recording.finish();
-}
-
-// After a frame's steps: what the trainee's guidance shows, and the alarm's sound.
-tools::GuidanceView guidanceView(Session& s, tools::AlarmSound& sound, Eigen::Matrix<double, Eigen::Dynamic, 3>& wire) {
-  tools::GuidanceView v;
-  const engine::Simulation& sim = *s.sim;
-  v.numbers = tools::guidanceNumbers(sim);
-  v.serosa_mm = tools::serosaDistanceMm(sim, wire);
-  v.margin_mm = sim.scene().safety.perforation_margin_mm;
-  v.cutting = sim.deviceState().pose.pedal;
-  v.alarm = s.monitor->alarm().active(sim.state().time);
-  v.scope_at_wall = s.scope != nullptr && s.scope->depthLimited();
-  s.monitor->scopeLimited(v.scope_at_wall, sim.state().time);
-  if (v.alarm) sound.beep();
-  return v;
-}
-
 // The first frame that draws the alarm: how long after the engine's event (simulated) and
 // after the raising step (wall) it came, and its picture when asked for.
 void reportAlarmFrame(const engine::Simulation& sim, const tools::SessionMonitor& monitor, double wall_s,
@@ -405,8 +240,8 @@ int runApp(const AppArgs& args) {
   const std::string scene_path = args.scene.empty() ? tools::defaultScenePath() : args.scene;
   auto scene = engine::loadScene(scene_path);
   if (!scene.ok()) return fail(scene.error());
-  Session session;
-  if (Status s = startSession(session, *scene, args.record); !s.ok()) return fail(s.error());
+  tools::Session session;
+  if (Status s = tools::startSession(session, *scene, args.record); !s.ok()) return fail(s.error());
   tools::AppGamepad gamepad;  // before the window: a missing pad or a bad mapping file stops here
   if (Status s = gamepad.configure(args.gamepad); !s.ok()) return fail(s.error());
 
@@ -426,9 +261,9 @@ int runApp(const AppArgs& args) {
   tools::AlarmSound sound;
   sound.open();
 
-  Panel panel;
+  tools::Panel panel;
   panel.paused = args.paused;
-  panel.lens_index = lensIndexFor(scene->camera.lens_deg);
+  panel.lens_index = tools::lensIndexFor(scene->camera.lens_deg);
   Pacer pacer;
   pacer.dt = scene->sim.dt;
   StepTimes step_times;
@@ -473,8 +308,8 @@ int runApp(const AppArgs& args) {
 
     if (panel.reset_requested) {
       panel.reset_requested = false;
-      endSession(session);  // a reset starts a new session, recorded and logged anew
-      if (Status s = startSession(session, *scene, ""); !s.ok()) return fail("reset: " + s.error());
+      tools::endSession(session);  // a reset starts a new session, recorded and logged anew
+      if (Status s = tools::startSession(session, *scene, ""); !s.ok()) return fail("reset: " + s.error());
       gamepad.release();    // (the pad's device went with the old simulation)
       panel.manual_requested = gamepad.enabled();
       panel.manual = false;
@@ -512,7 +347,7 @@ int runApp(const AppArgs& args) {
 
     // The scope view.
     sim.fillSnapshot(snapshot);
-    snapshot.camera.lens_deg = static_cast<float>(kLens[panel.lens_index]);
+    snapshot.camera.lens_deg = static_cast<float>(tools::kLens[panel.lens_index]);
     (*renderer)->draw(snapshot);
 
     const float panel_w = 300.0f;  // screen coordinates
@@ -522,9 +357,9 @@ int runApp(const AppArgs& args) {
 
     // The panel and the view's overlay.
     (*layer)->newFrame();
-    const tools::GuidanceView guidance = guidanceView(session, sound, wire);
-    FrameNumbers numbers{step_times.median(), realtime, frame_ms, pacer.behind_s, tool_force_n, max_force_n};
-    drawPanel(*scene, sim, panel, numbers, guidance, force_feedback, gamepad, session.recording, path_end_s, panel_w,
+    const tools::GuidanceView guidance = tools::guidanceView(session, sound, wire);
+    tools::FrameNumbers numbers{step_times.median(), StepTimes::kWindow, realtime, frame_ms, pacer.behind_s, tool_force_n, max_force_n};
+    tools::drawPanel(*scene, sim, panel, numbers, guidance, force_feedback, gamepad, session.recording, path_end_s, panel_w,
               static_cast<float>(wh));
     tools::drawViewOverlay(guidance, view, seconds(now - start));
     (*layer)->render();
@@ -545,7 +380,7 @@ int runApp(const AppArgs& args) {
   }
   const engine::Simulation& sim = *session.sim;
   const int alarms = session.monitor->alarm().raised();
-  endSession(session);
+  tools::endSession(session);
   std::printf("hysim-app: %ld frames, sim time %.3f s, %llu steps, warnings %d, perforations %d, alarms %d, "
               "state_hash %s\n",
               frame, sim.state().time, static_cast<unsigned long long>(sim.state().steps), sim.state().warnings,
