@@ -50,7 +50,7 @@ void drawGuidance(const GuidanceView& v) {
     ImGui::Text("perforations     %5d", n.perforations);
   }
   if (v.alarm) ImGui::TextColored(kRed, "PERFORATION: withdraw the loop");
-  if (v.scope_at_wall) ImGui::TextColored(kAmber, "scope at the wall: cannot go deeper");
+  if (v.scope_at_wall) ImGui::TextColored(kAmber, "scope held back at the wall");
 }
 
 void drawViewOverlay(const GuidanceView& v, const ViewRect& rect, double wall_s) {

@@ -19,7 +19,7 @@ struct GuidanceView {
   double margin_mm = 2.0;
   bool cutting = false;        // electrode active (pedal down)
   bool alarm = false;          // perforation alarm on
-  bool scope_at_wall = false;  // the keyboard scope was stopped short of the tissue
+  bool scope_at_wall = false;  // the keyboard scope was held back from the tissue (ahead or beside)
 };
 
 void drawGuidance(const GuidanceView& view);

@@ -15,9 +15,17 @@ inline constexpr double kFrontClearanceMm = 2.0;
 // Returns it (owned by the simulation).
 haptics::PivotScopeDevice* attachPivotScope(engine::Simulation& sim);
 
-// Before a frame's steps: the depth limit from the tissue surface as last drawn. The front of
-// the instrument is the loop, `loop_reach_mm` plus its extension ahead of the tip: the scope
-// stops when the loop would push into the tissue ahead; extending the loop is how it cuts.
-void limitDepth(haptics::PivotScopeDevice& scope, const render::SurfaceMesh& tissue, double loop_reach_mm);
+// What of the instrument meets the tissue: the loop, loop_reach_mm plus its extension ahead
+// of the tip, and the shaft's radius around it.
+struct ScopeSize {
+  double loop_reach_mm = 12.0;
+  double shaft_radius_mm = 4.0;
+};
+ScopeSize scopeSize(const engine::Simulation& sim);
+
+// Before a frame's steps: the scope's limits from the tissue surface as last drawn. Insertion
+// stops when the loop would push into the tissue ahead (extending the loop is how it cuts);
+// pivoting stops when the shaft's side would reach the wall beside the tip.
+void limitScope(haptics::PivotScopeDevice& scope, const render::SurfaceMesh& tissue, const ScopeSize& size);
 
 }  // namespace hysim::tools

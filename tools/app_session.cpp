@@ -39,7 +39,7 @@ GuidanceView guidanceView(Session& s, AlarmSound& sound, Eigen::Matrix<double, E
   v.margin_mm = sim.scene().safety.perforation_margin_mm;
   v.cutting = sim.deviceState().pose.pedal;
   v.alarm = s.monitor->alarm().active(sim.state().time);
-  v.scope_at_wall = s.scope != nullptr && s.scope->depthLimited();
+  v.scope_at_wall = s.scope != nullptr && (s.scope->depthLimited() || s.scope->sideLimited());
   s.monitor->scopeLimited(v.scope_at_wall, sim.state().time);
   if (v.alarm) sound.beep();
   return v;

@@ -324,7 +324,7 @@ int runApp(const AppArgs& args) {
                    session.monitor->alarm().active(sim.state().time));
     if (session.scope != nullptr) {
       session.scope->setCommand(tools::pivotCommand(heldKeys()));
-      tools::limitDepth(*session.scope, snapshot.tissue, sim.loop().reach_mm);
+      tools::limitScope(*session.scope, snapshot.tissue, tools::scopeSize(sim));
     }
 
     // Fixed steps due for the wall time since the last frame.

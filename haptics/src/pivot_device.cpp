@@ -49,6 +49,22 @@ ToolPose PivotScopeDevice::pose() const {
   return p;
 }
 
+void PivotScopeDevice::setSideRoom(const Eigen::Vector3d& from, const std::array<Eigen::Vector3d, 4>& directions,
+                                   const std::array<double, 4>& room_mm) {
+  side_from_ = from;
+  side_directions_ = directions;
+  side_room_ = room_mm;
+}
+
+bool PivotScopeDevice::sideBlocked(const Eigen::Vector3d& tip_before, const Eigen::Vector3d& tip_after) const {
+  for (std::size_t i = 0; i < side_room_.size(); ++i) {
+    const double before = (tip_before - side_from_).dot(side_directions_[i]);
+    const double after = (tip_after - side_from_).dot(side_directions_[i]);
+    if (after > side_room_[i] && after > before) return true;
+  }
+  return false;
+}
+
 void PivotScopeDevice::turn(double dt) {
   const Eigen::Vector3d roll = command_.roll_rad_s * rotation_.col(2);
   const Eigen::Vector3d omega = command_.yaw_rad_s * rotation_.col(1) + command_.pitch_rad_s * rotation_.col(0) + roll;
@@ -57,7 +73,8 @@ void PivotScopeDevice::turn(double dt) {
   const double tilt_after = angleBetween(next.col(2), reference_axis_);
   // Outside the cone only a turn back towards it is taken: the shaft would leave the cavity.
   tilt_limited_ = tilt_after > limits_.max_tilt_rad && tilt_after > tilt_before;
-  rotation_ = tilt_limited_ ? rotated(rotation_, roll, dt) : next;
+  side_limited_ = sideBlocked(trocar_ + depth_ * rotation_.col(2), trocar_ + depth_ * next.col(2));
+  rotation_ = tilt_limited_ || side_limited_ ? rotated(rotation_, roll, dt) : next;
 }
 
 void PivotScopeDevice::insert(double dt) {

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 
 #include "hysim/haptics/pivot_device.hpp"
 
@@ -112,6 +113,25 @@ TEST(PivotScopeDevice, StartsOnTheLineFromTheTrocarThroughTheTip) {
   const DeviceState s = dev.read(0.0);
   EXPECT_LT((s.pose.tip - p.tip).norm(), 1e-9);
   EXPECT_LT(offLine(kTrocar, s.pose.tip, s.pose.rotation.col(2)), 1e-9);
+}
+
+TEST(PivotScopeDevice, SideRoomStopsATurnIntoTheWallButNotOneAway) {
+  PivotScopeDevice dev(kTrocar, startPose(), 0.0, Eigen::Vector3d(0, 0, 1));
+  const double inf = std::numeric_limits<double>::infinity();
+  dev.setSideRoom(startPose().tip, {Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(-1, 0, 0), Eigen::Vector3d(0, 1, 0),
+                                    Eigen::Vector3d(0, -1, 0)},
+                  {inf, inf, 1.0, inf});
+  PivotCommand up;
+  up.pitch_rad_s = -0.3;  // the view, and the tip, turn up
+  DeviceState s = hold(dev, up, 0.0, 1.0);  // 4.8 mm wanted, 1 mm of room
+  EXPECT_LE(s.pose.tip.y(), 1.0);
+  EXPECT_GT(s.pose.tip.y(), 0.9);
+  EXPECT_TRUE(dev.sideLimited());
+  PivotCommand down;
+  down.pitch_rad_s = 0.3;
+  s = hold(dev, down, 1.0, 0.5);
+  EXPECT_LT(s.pose.tip.y(), -1.0);
+  EXPECT_FALSE(dev.sideLimited());
 }
 
 }  // namespace

@@ -12,6 +12,7 @@
 #include "app_keys.hpp"
 #include "app_monitor.hpp"
 #include "app_pivot_scope.hpp"
+#include "app_scope_limits.hpp"
 #include "hysim/engine/scene.hpp"
 #include "hysim/engine/simulation.hpp"
 #include "test_dir.hpp"
@@ -40,14 +41,16 @@ class KeyboardDriver {
     const int steps = static_cast<int>(seconds / sim_.scene().sim.dt + 0.5);
     for (int done = 0; done < steps;) {
       sim_.fillSnapshot(snapshot_);
-      limitDepth(*scope_, snapshot_.tissue, sim_.loop().reach_mm);
+      limitScope(*scope_, snapshot_.tissue, scopeSize(sim_));
       scope_->setCommand(pivotCommand(keys));
       done += stepWatched(sim_, monitor_, std::min(frame_steps, steps - done));
       at_wall_ = at_wall_ || scope_->depthLimited();
+      side_ = side_ || scope_->sideLimited();
     }
   }
   haptics::PivotScopeDevice& scope() { return *scope_; }
   bool stoppedAtWall() const { return at_wall_; }
+  bool stoppedAtSide() const { return side_; }
 
  private:
   engine::Simulation& sim_;
@@ -55,6 +58,7 @@ class KeyboardDriver {
   haptics::PivotScopeDevice* scope_;
   render::RenderSnapshot snapshot_;
   bool at_wall_ = false;
+  bool side_ = false;
 };
 
 std::string readFile(const std::string& path) {
@@ -123,6 +127,35 @@ TEST(TraineeSession, HoldingInsertStopsShortOfTheFundus) {
   EXPECT_GT(sim->outerWall().signedDistance(tip.tip), 5.0);  // well inside the uterus
   EXPECT_LT(tip.tip.z(), 24.0);                             // short of the cavity's far end
   EXPECT_EQ(sim->perforations(), 0);
+}
+
+// Deep in the cavity the tip is near the anterior wall: pivoting up towards it stops where
+// it is (the shaft's side would be in the wall); pivoting away is free.
+TEST(TraineeSession, PivotingStopsBeforeTheWallBeside) {
+  auto sim = load("default.yaml");
+  SessionMonitor monitor;
+  KeyboardDriver keys(*sim, monitor);
+  TraineeKeys k;
+  k.insert = true;
+  keys.hold(k, 2.0);
+  render::RenderSnapshot snapshot;
+  const auto freeUp = [&] {
+    sim->fillSnapshot(snapshot);
+    const haptics::ToolPose pose = keys.scope().pose();
+    return forwardFreeMm(snapshot.tissue, pose.tip, pose.rotation.col(1));
+  };
+  const double free_before = freeUp();
+  ASSERT_LT(free_before, scopeSize(*sim).shaft_radius_mm);  // the case this test is about
+  k = {};
+  k.pivot_up = true;
+  keys.hold(k, 1.0);  // 0.3 rad wanted: about 6 mm towards the wall
+  EXPECT_TRUE(keys.stoppedAtSide());
+  EXPECT_GT(freeUp(), free_before - 0.3);
+  const Eigen::Vector3d tip_before = keys.scope().pose().tip;
+  k = {};
+  k.pivot_down = true;
+  keys.hold(k, 0.3);
+  EXPECT_LT(keys.scope().pose().tip.y(), tip_before.y() - 1.0);
 }
 
 // The alarm is raised at the step the engine opens its perforation event, and stepping stops

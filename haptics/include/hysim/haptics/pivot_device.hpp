@@ -4,10 +4,12 @@
 // and pitch about the trocar), roll about the shaft (which turns the fore-oblique lens) and the
 // loop's extension, as with a real scope. Depth is kept within [min, limit]: the app sets the
 // limit from the cavity's free space in front of the tip each frame, so the scope cannot be
-// driven through the fundus; the shaft's tilt from the reference axis is kept within a cone.
+// driven through the fundus, and the room beside the tip, so it cannot be swung into the wall;
+// the shaft's tilt from the reference axis is kept within a cone.
 // read(t) integrates the current command from the last read to t: the same command stream
 // gives the same path.
 #include <Eigen/Core>
+#include <array>
 #include <limits>
 
 #include "hysim/haptics/device.hpp"
@@ -42,6 +44,11 @@ class PivotScopeDevice final : public Device {
   // Deepest the tip may go (trocar to tip, mm); +inf: no limit. A limit below the current
   // depth stops further insertion without pulling the scope back.
   void setDepthLimit(double max_depth_mm) { depth_limit_ = max_depth_mm; }
+  // Room the tip has sideways: from `from`, it may move at most room_mm[i] along the unit
+  // direction directions[i]; a turn that would take it further (and not back) is not taken.
+  // Like the depth limit, set each frame from the free space around the tip.
+  void setSideRoom(const Eigen::Vector3d& from, const std::array<Eigen::Vector3d, 4>& directions,
+                   const std::array<double, 4>& room_mm);
   double depth() const { return depth_; }
   // The pose as of the last read (its tip lies on the shaft's line through the trocar).
   ToolPose pose() const;
@@ -49,6 +56,7 @@ class PivotScopeDevice final : public Device {
   // The last read had to stop the insertion (at the depth limit) or the tilt (at the cone).
   bool depthLimited() const { return depth_limited_; }
   bool tiltLimited() const { return tilt_limited_; }
+  bool sideLimited() const { return side_limited_; }
 
   const DeviceInfo& info() const override { return info_; }
   DeviceState read(double time_s) override;
@@ -56,7 +64,8 @@ class PivotScopeDevice final : public Device {
   const Eigen::Vector3d& lastForce() const override { return last_force_; }
 
  private:
-  void turn(double dt);     // yaw, pitch and roll, kept within the tilt cone
+  void turn(double dt);     // yaw, pitch and roll, kept within the tilt cone and the side room
+  bool sideBlocked(const Eigen::Vector3d& tip_before, const Eigen::Vector3d& tip_after) const;
   void insert(double dt);   // depth, kept within [min_depth, depth limit]
 
   Eigen::Vector3d trocar_;
@@ -69,6 +78,11 @@ class PivotScopeDevice final : public Device {
   double depth_limit_ = std::numeric_limits<double>::infinity();
   bool depth_limited_ = false;
   bool tilt_limited_ = false;
+  bool side_limited_ = false;
+  Eigen::Vector3d side_from_{0, 0, 0};
+  std::array<Eigen::Vector3d, 4> side_directions_{};
+  std::array<double, 4> side_room_{std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(),
+                                   std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
   PivotCommand command_;
   DeviceInfo info_;
   Eigen::Vector3d last_force_{0, 0, 0};
