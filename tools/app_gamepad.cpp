@@ -53,9 +53,9 @@ bool AppGamepad::attach(engine::Simulation& sim) {
   return true;
 }
 
-void AppGamepad::update(const engine::Simulation& sim, double perforation_margin_mm, int& lens_index) {
+void AppGamepad::update(const engine::Simulation& sim, double perforation_margin_mm, int& lens_index, bool alarm) {
   if (device_ == nullptr) return;
-  device_->setSerosaWarning(sim.deviceState().pose.pedal && sim.serosaClearanceMm() < perforation_margin_mm);
+  device_->setSerosaWarning(alarm || (sim.deviceState().pose.pedal && sim.serosaClearanceMm() < perforation_margin_mm));
   if (last_lens_index_ >= 0 && device_->lensIndex() != last_lens_index_) {
     lens_index = device_->lensIndex();  // the pad's button was pressed
   } else {

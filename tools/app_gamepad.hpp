@@ -36,9 +36,10 @@ class AppGamepad {
   void release() { device_ = nullptr; }
   bool active() const { return device_ != nullptr; }
 
-  // Before a frame's steps: the serosa cue (the active wire within the perforation margin)
-  // and the lens angle, which the pad's button and the panel both change.
-  void update(const engine::Simulation& sim, double perforation_margin_mm, int& lens_index);
+  // Before a frame's steps: the serosa cue (the active wire within the perforation margin, or
+  // the perforation alarm on: the force cue) and the lens angle, which the pad's button and the
+  // panel both change.
+  void update(const engine::Simulation& sim, double perforation_margin_mm, int& lens_index, bool alarm);
   // The panel's controller section: name, a red warning while unplugged, the cues.
   void drawPanel() const;
 

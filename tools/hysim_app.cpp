@@ -21,9 +21,18 @@
 #include <vector>
 
 #include "hysim/engine/run.hpp"
+#include "app_beep.hpp"
 #include "app_gamepad.hpp"
-#include "app_recording.hpp"
+#include "app_guidance.hpp"
+#include "app_guidance_panel.hpp"
 #include "app_haptics.hpp"
+#include "app_keys.hpp"
+#include "app_monitor.hpp"
+#include "app_pivot_scope.hpp"
+#include "app_panel.hpp"
+#include "app_recording.hpp"
+#include "app_session.hpp"
+#include "app_session_log.hpp"
 #include "tool_common.hpp"
 #include "hysim/engine/scene.hpp"
 #include "hysim/engine/simulation.hpp"
@@ -51,6 +60,7 @@ struct AppArgs {
   int frames = -1;            // quit after this many frames (-1: never)
   double quit_after_s = -1.0; // quit after this much wall time (-1: never)
   std::string screenshot;     // PNG of the last frame, written on exit
+  std::string alarm_screenshot;  // PNG of the first frame that shows the perforation alarm
   int width = 1024;
   int height = 768;
   bool no_vsync = false;
@@ -109,56 +119,39 @@ struct Pacer {
     behind_s += not_stepped * dt + accumulator;
     accumulator = 0.0;
   }
+  // Called when stepping stopped early to show something at once: the rest is stepped next frame.
+  void keep(int not_stepped) { accumulator += not_stepped * dt; }
   void reset() { accumulator = behind_s = 0.0; }
 };
 
-struct Panel {
-  bool paused = false;
-  bool reset_requested = false;
-  int lens_index = 2;  // 0, 12, 30 degrees
-  float speed = 1.0f;
-  bool manual = false;  // keyboard drives the scope instead of the scripted path
-  bool manual_requested = false;
-  bool pedal = false;
-};
-
-// Keyboard -> rate command for the manual device: W/S forward/back along the axis,
-// arrows left/right/up/down (strafe), A/D yaw, PageUp/PageDown pitch, Q/E retract/extend
-// the loop.
-haptics::ManualCommand keyboardCommand(bool pedal) {
+// The trainee's keys held now (see app_keys.hpp for what each does).
+tools::TraineeKeys heldKeys() {
   const Uint8* k = SDL_GetKeyboardState(nullptr);
-  constexpr double kSpeed = 10.0;   // mm/s
-  constexpr double kTurn = 0.6;     // rad/s
-  constexpr double kExtend = 5.0;   // mm/s
-  haptics::ManualCommand c;
-  c.velocity_scope_mm_s.z() = kSpeed * ((k[SDL_SCANCODE_W] ? 1 : 0) - (k[SDL_SCANCODE_S] ? 1 : 0));
-  c.velocity_scope_mm_s.x() = kSpeed * ((k[SDL_SCANCODE_RIGHT] ? 1 : 0) - (k[SDL_SCANCODE_LEFT] ? 1 : 0));
-  c.velocity_scope_mm_s.y() = kSpeed * ((k[SDL_SCANCODE_UP] ? 1 : 0) - (k[SDL_SCANCODE_DOWN] ? 1 : 0));
-  c.yaw_rad_s = kTurn * ((k[SDL_SCANCODE_A] ? 1 : 0) - (k[SDL_SCANCODE_D] ? 1 : 0));
-  c.pitch_rad_s = kTurn * ((k[SDL_SCANCODE_PAGEDOWN] ? 1 : 0) - (k[SDL_SCANCODE_PAGEUP] ? 1 : 0));
-  c.extension_mm_s = kExtend * ((k[SDL_SCANCODE_E] ? 1 : 0) - (k[SDL_SCANCODE_Q] ? 1 : 0));
-  c.pedal = pedal;
-  return c;
-}
-
-constexpr std::array<int, 3> kLens = {0, 12, 30};
-
-int lensIndexFor(double deg) {
-  int best = 0;
-  for (int i = 1; i < 3; ++i) {
-    if (std::fabs(kLens[i] - deg) < std::fabs(kLens[best] - deg)) best = i;
-  }
-  return best;
+  tools::TraineeKeys keys;
+  keys.insert = k[SDL_SCANCODE_W];
+  keys.withdraw = k[SDL_SCANCODE_S];
+  keys.pivot_left = k[SDL_SCANCODE_LEFT];
+  keys.pivot_right = k[SDL_SCANCODE_RIGHT];
+  keys.pivot_up = k[SDL_SCANCODE_UP];
+  keys.pivot_down = k[SDL_SCANCODE_DOWN];
+  keys.roll_left = k[SDL_SCANCODE_A];
+  keys.roll_right = k[SDL_SCANCODE_D];
+  keys.loop_in = k[SDL_SCANCODE_Q];
+  keys.loop_out = k[SDL_SCANCODE_E];
+  keys.pedal_c = k[SDL_SCANCODE_C];
+  keys.pedal_shift = k[SDL_SCANCODE_LSHIFT];
+  return keys;
 }
 
 // A key the panel did not take. True: quit.
-bool handleKey(SDL_Keycode key, Panel& panel, tools::AppHaptics& force_feedback) {
+bool handleKey(SDL_Keycode key, tools::Panel& panel, tools::AppHaptics& force_feedback) {
   switch (key) {
     case SDLK_ESCAPE: return true;
     case SDLK_SPACE: panel.paused = !panel.paused; break;
     case SDLK_r: panel.reset_requested = true; break;
     case SDLK_l: panel.lens_index = (panel.lens_index + 1) % 3; break;
     case SDLK_m: panel.manual_requested = true; break;
+    case SDLK_i: panel.details = !panel.details; break;
     case SDLK_x: force_feedback.eStop(); break;
     case SDLK_f: force_feedback.resetSafety(); break;
     default: break;
@@ -166,8 +159,11 @@ bool handleKey(SDL_Keycode key, Panel& panel, tools::AppHaptics& force_feedback)
   return false;
 }
 
-// The fixed steps due for the wall time since the last frame, within the frame's budget.
-void stepDue(engine::Simulation& sim, Pacer& pacer, StepTimes& step_times, Clock::time_point now, double elapsed) {
+// The fixed steps due for the wall time since the last frame, within the frame's budget, each
+// watched by the monitor; a step that raises the alarm ends the frame's stepping so that the
+// alarm is drawn at once. True when a step raised the alarm.
+bool stepDue(engine::Simulation& sim, tools::SessionMonitor& monitor, Pacer& pacer, StepTimes& step_times,
+             Clock::time_point now, double elapsed) {
   const int due = pacer.due(elapsed);
   const Clock::time_point budget_end =
       now + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(pacer.step_budget_s));
@@ -179,44 +175,19 @@ void stepDue(engine::Simulation& sim, Pacer& pacer, StepTimes& step_times, Clock
     }
     sim.step();
     step_times.add(1e6 * seconds(Clock::now() - t0));
+    if (monitor.afterStep(sim)) {
+      pacer.keep(due - i - 1);
+      return true;
+    }
   }
+  return false;
 }
 
-// The panel's controls: pause, reset, speed, lens, manual scope, and the keys.
-void drawControls(Panel& panel) {
-  if (ImGui::Button(panel.paused ? "Resume (Space)" : "Pause (Space)", ImVec2(-1, 0))) {
-    panel.paused = !panel.paused;
-  }
-  if (ImGui::Button("Reset (R)", ImVec2(-1, 0))) panel.reset_requested = true;
-  ImGui::SliderFloat("speed", &panel.speed, 0.05f, 1.0f, "%.2fx");
-  ImGui::Text("lens (L)");
-  for (int i = 0; i < 3; ++i) {
-    char label[16];
-    std::snprintf(label, sizeof(label), "%d deg", kLens[i]);
-    if (i > 0) ImGui::SameLine();
-    ImGui::RadioButton(label, &panel.lens_index, i);
-  }
-  ImGui::Separator();
-  if (ImGui::Checkbox("manual scope (M)", &panel.manual)) {
-    panel.manual = !panel.manual;  // applied (and toggled) at the top of the next frame
-    panel.manual_requested = true;
-  }
-  if (panel.manual) {
-    ImGui::TextDisabled("W/S forward/back, arrows move");
-    ImGui::TextDisabled("A/D yaw, PgUp/PgDn pitch");
-    ImGui::TextDisabled("Q/E loop in/out");
-  } else {
-    ImGui::TextDisabled("scope follows the scene's scripted path");
-  }
-  ImGui::TextDisabled("X: force e-stop, F: reset force");
-  ImGui::TextDisabled("Esc: quit");
-}
-
-// Manual control: the game controller (when one is used) or else a keyboard device takes over
-// from the device's current pose (M toggles); back to the script otherwise. Returns the
-// keyboard device (owned by the simulation) or null.
-haptics::ManualDevice* toggleManual(engine::Simulation& sim, const engine::Scene& scene, Panel& panel,
-                                    tools::AppGamepad& gamepad) {
+// Manual control: the game controller (when one is used) or else the keyboard scope, pivoting
+// at the cervix, takes over from the device's current pose (M toggles); back to the script
+// otherwise. Returns the keyboard scope (owned by the simulation) or null.
+haptics::PivotScopeDevice* toggleManual(engine::Simulation& sim, const engine::Scene& scene, tools::Panel& panel,
+                                        tools::AppGamepad& gamepad) {
   panel.manual_requested = false;
   panel.manual = !panel.manual;
   gamepad.release();  // whatever comes next replaces the simulation's device
@@ -225,14 +196,12 @@ haptics::ManualDevice* toggleManual(engine::Simulation& sim, const engine::Scene
     sim.setDevice(std::make_unique<haptics::ScriptedDevice>(haptics::Trajectory(scene.tool_path)));
     return nullptr;
   }
-  auto* device = new haptics::ManualDevice(sim.deviceState().pose, sim.state().time);
-  sim.setDevice(std::unique_ptr<haptics::Device>(device));
-  return device;
+  return tools::attachPivotScope(sim);
 }
 
 // Scales the rendered scope view into the window right of the panel (panel_w in screen
-// coordinates). Returns the window's height in screen coordinates, for the panel.
-int blitView(render::SdlWindow& window, render::Renderer& renderer, float panel_w) {
+// coordinates). Returns where the view lies, in screen coordinates.
+tools::ViewRect blitView(render::SdlWindow& window, render::Renderer& renderer, float panel_w) {
   int dw = 0, dh = 0, ww = 0, wh = 0;
   window.drawableSize(dw, dh);
   SDL_GetWindowSize(window.nativeWindow(), &ww, &wh);
@@ -243,74 +212,36 @@ int blitView(render::SdlWindow& window, render::Renderer& renderer, float panel_
                               static_cast<double>(area_h) / renderer.height());
   const int vw = static_cast<int>(renderer.width() * fit);
   const int vh = static_cast<int>(renderer.height() * fit);
+  const int vx = panel_px + (area_w - vw) / 2, vy = (area_h - vh) / 2;
   window.clear(0.08f, 0.08f, 0.09f);
-  renderer.blitTo(0, panel_px + (area_w - vw) / 2, (area_h - vh) / 2, vw, vh);
-  return wh;
+  renderer.blitTo(0, vx, vy, vw, vh);
+  return {ImVec2(vx / scale, vy / scale), ImVec2((vx + vw) / scale, (vy + vh) / scale)};
 }
 
-// The numbers of the frame the panel shows.
-struct FrameNumbers {
-  double step_median_us = 0.0;
-  double realtime = 0.0;
-  double frame_ms = 0.0;
-  double behind_s = 0.0;
-  double tool_force_n = 0.0;
-  double max_force_n = 0.0;
-};
-
-// The panel: what runs, how fast, the forces, the controller, the controls.
-void drawPanel(const engine::Scene& scene, const engine::Simulation& sim, Panel& panel, const FrameNumbers& n,
-               tools::AppHaptics& force_feedback, const tools::AppGamepad& gamepad,
-               const tools::AppRecording& recording, double path_end_s, float panel_w, float panel_h) {
-  ImGui::SetNextWindowPos(ImVec2(0, 0));
-  ImGui::SetNextWindowSize(ImVec2(panel_w, panel_h));
-  ImGui::Begin("hysim", nullptr,
-               ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse);
-  ImGui::TextWrapped("%s", scene.description.empty() ? scene.name.c_str() : scene.description.c_str());
-  ImGui::Separator();
-  const sim::State& st = sim.state();
-  if (panel.paused) ImGui::TextColored(ImVec4(0.4f, 0.8f, 1.0f, 1.0f), "PAUSED");
-  ImGui::Text("sim time     %8.3f s", st.time);
-  ImGui::Text("steps        %8llu  (dt %.3g ms)", static_cast<unsigned long long>(st.steps), 1e3 * scene.sim.dt);
-  ImGui::Text("step time    %8.1f us  (median of %d)", n.step_median_us, StepTimes::kWindow);
-  ImGui::Text("substeps     %8d", sim.model().substeps);
-  ImGui::Text("real time    %8.2f x", n.realtime);
-  ImGui::Text("frame        %8.1f ms", n.frame_ms);
-  if (n.behind_s > 0.05) {
-    // The simulation is never skipped ahead: a too slow machine runs in slow motion.
-    ImGui::TextColored(ImVec4(1.0f, 0.75f, 0.3f, 1.0f), "behind real time by %.2f s", n.behind_s);
+// The first frame that draws the alarm: how long after the engine's event (simulated) and
+// after the raising step (wall) it came, and its picture when asked for.
+void reportAlarmFrame(const engine::Simulation& sim, const tools::SessionMonitor& monitor, double wall_s,
+                      const std::string& screenshot, render::SdlWindow& window) {
+  const double event_s = sim.perforationEvents().empty() ? monitor.alarm().raisedAtS()
+                                                         : sim.perforationEvents().front().time_s;
+  std::printf("hysim-app: perforation alarm: engine event at %.3f s, raised at the step of %.3f s, drawn %.1f ms "
+              "(wall) after that step\n",
+              event_s, monitor.alarm().raisedAtS(), 1e3 * wall_s);
+  if (screenshot.empty()) return;
+  const render::Image shot = window.readBackBuffer();
+  if (Status s = render::writePng(screenshot, shot); !s.ok()) {
+    std::printf("hysim-app: %s\n", s.error().c_str());
+    return;
   }
-  ImGui::Separator();
-  ImGui::Text("tool force   %8.3f N", n.tool_force_n);
-  ImGui::Text("max force    %8.3f N", n.max_force_n);
-  force_feedback.drawPanel();
-  if (st.warnings > 0) {
-    ImGui::TextColored(ImVec4(1.0f, 0.35f, 0.3f, 1.0f), "warnings     %8d  (numerical trouble)", st.warnings);
-  } else {
-    ImGui::Text("warnings     %8d", st.warnings);
-  }
-  const char* path = gamepad.active() ? "game controller"
-                     : panel.manual   ? "manual (keyboard)"
-                     : st.time < path_end_s ? "scripted"
-                                            : "done (holding last pose)";
-  ImGui::Text("tool path    %s", path);
-  if (gamepad.active()) {
-    ImGui::Separator();
-    gamepad.drawPanel();
-  }
-  recording.drawPanel();
-  ImGui::Separator();
-  drawControls(panel);
-  ImGui::End();
+  std::printf("hysim-app: alarm screenshot %s\n", screenshot.c_str());
 }
 
 int runApp(const AppArgs& args) {
   const std::string scene_path = args.scene.empty() ? tools::defaultScenePath() : args.scene;
   auto scene = engine::loadScene(scene_path);
   if (!scene.ok()) return fail(scene.error());
-  auto created = engine::Simulation::create(*scene);
-  if (!created.ok()) return fail(created.error());
-  std::unique_ptr<engine::Simulation> sim = std::move(created.value());
+  tools::Session session;
+  if (Status s = tools::startSession(session, *scene, args.record); !s.ok()) return fail(s.error());
   tools::AppGamepad gamepad;  // before the window: a missing pad or a bad mapping file stops here
   if (Status s = gamepad.configure(args.gamepad); !s.ok()) return fail(s.error());
 
@@ -327,29 +258,32 @@ int runApp(const AppArgs& args) {
   if (!layer.ok()) return fail(layer.error());
   std::printf("hysim-app: scene %s (%s); %s\n", scene->name.c_str(), scene_path.c_str(),
               (*window)->description().c_str());
+  tools::AlarmSound sound;
+  sound.open();
 
-  Panel panel;
+  tools::Panel panel;
   panel.paused = args.paused;
-  panel.lens_index = lensIndexFor(scene->camera.lens_deg);
+  panel.lens_index = tools::lensIndexFor(scene->camera.lens_deg);
   Pacer pacer;
   pacer.dt = scene->sim.dt;
   StepTimes step_times;
   render::RenderSnapshot snapshot;
+  session.sim->fillSnapshot(snapshot);  // the keyboard scope's first depth limit
+  Eigen::Matrix<double, Eigen::Dynamic, 3> wire;
   double max_force_n = 0.0;
   double frame_ms = 0.0;   // smoothed wall time per frame
   double realtime = 0.0;   // smoothed simulated seconds per wall second
   const double path_end_s = haptics::Trajectory(scene->tool_path).duration();
 
-  haptics::ManualDevice* manual_device = nullptr;  // owned by the simulation while in use
   tools::AppHaptics force_feedback;
-  tools::AppRecording recording;
-  recording.start(*scene, *sim, args.record);
   panel.manual_requested = gamepad.enabled();  // the pad takes the tool at the first frame
 
   const Clock::time_point start = Clock::now();
   Clock::time_point last = start;
   long frame = 0;
   bool quit = false;
+  bool alarm_raised = false, alarm_shot_done = false;  // the session's first alarm, for --alarm-screenshot
+  Clock::time_point alarm_step_wall;
   while (true) {
     // Events. Every way out (Esc, window close, --frames, --quit-after-s) still draws this
     // frame, so --screenshot always gets a complete last frame.
@@ -374,55 +308,68 @@ int runApp(const AppArgs& args) {
 
     if (panel.reset_requested) {
       panel.reset_requested = false;
-      auto fresh = engine::Simulation::create(*scene);
-      if (!fresh.ok()) return fail("reset: " + fresh.error());
-      recording.finish();  // a reset starts a new session, recorded anew
-      sim = std::move(fresh.value());
-      recording.start(*scene, *sim);
-      manual_device = nullptr;  // the fresh simulation follows the script again
-      gamepad.release();        // (the pad's device went with the old simulation)
+      tools::endSession(session);  // a reset starts a new session, recorded and logged anew
+      if (Status s = tools::startSession(session, *scene, ""); !s.ok()) return fail("reset: " + s.error());
+      gamepad.release();    // (the pad's device went with the old simulation)
       panel.manual_requested = gamepad.enabled();
       panel.manual = false;
       pacer.reset();
       step_times.clear();
       max_force_n = 0.0;
     }
+    engine::Simulation& sim = *session.sim;
 
-    if (panel.manual_requested) manual_device = toggleManual(*sim, *scene, panel, gamepad);
-    gamepad.update(*sim, scene->safety.perforation_margin_mm, panel.lens_index);
-    if (manual_device != nullptr) manual_device->setCommand(keyboardCommand(panel.pedal));
+    if (panel.manual_requested) session.scope = toggleManual(sim, *scene, panel, gamepad);
+    gamepad.update(sim, scene->safety.perforation_margin_mm, panel.lens_index,
+                   session.monitor->alarm().active(sim.state().time));
+    if (session.scope != nullptr) {
+      session.scope->setCommand(tools::pivotCommand(heldKeys()));
+      tools::limitScope(*session.scope, snapshot.tissue, tools::scopeSize(sim));
+    }
 
     // Fixed steps due for the wall time since the last frame.
-    const double sim_before = sim->state().time;
+    const double sim_before = sim.state().time;
     if (!panel.paused) {
       pacer.speed = panel.speed;
-      stepDue(*sim, pacer, step_times, now, elapsed);
+      if (stepDue(sim, *session.monitor, pacer, step_times, now, elapsed) && !alarm_raised) {
+        alarm_raised = true;
+        alarm_step_wall = Clock::now();
+      }
     }
-    force_feedback.publish(*sim);
-    const double tool_force_n = sim->toolForceN().norm();
+    force_feedback.publish(sim);
+    const double tool_force_n = sim.toolForceN().norm();
     max_force_n = std::max(max_force_n, tool_force_n);
     if (elapsed > 0.0) {
       const double a = std::min(1.0, elapsed / 0.5);  // ~0.5 s smoothing
       frame_ms += a * (1e3 * elapsed - frame_ms);
-      realtime += a * ((sim->state().time - sim_before) / elapsed - realtime);
+      realtime += a * ((sim.state().time - sim_before) / elapsed - realtime);
     }
 
     // The scope view.
-    sim->fillSnapshot(snapshot);
-    snapshot.camera.lens_deg = static_cast<float>(kLens[panel.lens_index]);
+    sim.fillSnapshot(snapshot);
+    snapshot.camera.lens_deg = static_cast<float>(tools::kLens[panel.lens_index]);
     (*renderer)->draw(snapshot);
 
     const float panel_w = 300.0f;  // screen coordinates
-    const int wh = blitView(**window, **renderer, panel_w);
+    const tools::ViewRect view = blitView(**window, **renderer, panel_w);
+    int ww = 0, wh = 0;
+    SDL_GetWindowSize((*window)->nativeWindow(), &ww, &wh);
 
-    // The panel.
+    // The panel and the view's overlay.
     (*layer)->newFrame();
-    FrameNumbers numbers{step_times.median(), realtime, frame_ms, pacer.behind_s, tool_force_n, max_force_n};
-    drawPanel(*scene, *sim, panel, numbers, force_feedback, gamepad, recording, path_end_s, panel_w,
+    const tools::GuidanceView guidance = tools::guidanceView(session, sound, wire);
+    tools::FrameNumbers numbers{step_times.median(), StepTimes::kWindow, realtime, frame_ms, pacer.behind_s, tool_force_n, max_force_n};
+    tools::drawPanel(*scene, sim, panel, numbers, guidance, force_feedback, gamepad, session.recording, path_end_s, panel_w,
               static_cast<float>(wh));
+    tools::drawViewOverlay(guidance, view, seconds(now - start));
     (*layer)->render();
 
     ++frame;
+    if (alarm_raised && !alarm_shot_done) {
+      alarm_shot_done = true;
+      reportAlarmFrame(sim, *session.monitor, seconds(Clock::now() - alarm_step_wall), args.alarm_screenshot,
+                       **window);
+    }
     if (quit && !args.screenshot.empty()) {
       const render::Image shot = (*window)->readBackBuffer();
       if (Status s = render::writePng(args.screenshot, shot); !s.ok()) return fail(s.error());
@@ -431,10 +378,13 @@ int runApp(const AppArgs& args) {
     (*window)->swapBuffers();
     if (quit) break;
   }
-  recording.finish();
-  std::printf("hysim-app: %ld frames, sim time %.3f s, %llu steps, warnings %d, state_hash %s\n", frame,
-              sim->state().time, static_cast<unsigned long long>(sim->state().steps), sim->state().warnings,
-              engine::hashHex(sim->stateHash()).c_str());
+  const engine::Simulation& sim = *session.sim;
+  const int alarms = session.monitor->alarm().raised();
+  tools::endSession(session);
+  std::printf("hysim-app: %ld frames, sim time %.3f s, %llu steps, warnings %d, perforations %d, alarms %d, "
+              "state_hash %s\n",
+              frame, sim.state().time, static_cast<unsigned long long>(sim.state().steps), sim.state().warnings,
+              sim.perforations(), alarms, engine::hashHex(sim.stateHash()).c_str());
   return 0;
 }
 
@@ -448,6 +398,8 @@ int main(int argc, char** argv) {
   app.add_option("--quit-after-s", args.quit_after_s, "Quit after S seconds of wall time")
       ->check(tools::finiteRange(0, 1e6));
   app.add_option("--screenshot", args.screenshot, "Save the last window frame as PNG on exit");
+  app.add_option("--alarm-screenshot", args.alarm_screenshot,
+                 "Save the first frame that shows the perforation alarm as PNG");
   app.add_option("--width", args.width, "Window width")->check(CLI::Range(320, 16384));
   app.add_option("--height", args.height, "Window height")->check(CLI::Range(240, 16384));
   app.add_flag("--no-vsync", args.no_vsync, "Do not wait for the display's refresh");
