@@ -79,8 +79,8 @@ void drawDetails(const engine::Scene& scene, const engine::Simulation& sim, cons
 // The panel: the case, the trainee's guidance, the controller, the controls, and the details.
 void drawPanel(const engine::Scene& scene, const engine::Simulation& sim, Panel& panel, const FrameNumbers& n,
                const GuidanceView& guidance, AppHaptics& force_feedback,
-               const AppGamepad& gamepad, const AppRecording& recording, double path_end_s,
-               float panel_w, float panel_h) {
+               const AppGamepad& gamepad, const AppRecording& recording, const AppSessionStore& store,
+               double path_end_s, float panel_w, float panel_h) {
   ImGui::SetNextWindowPos(ImVec2(0, 0));
   ImGui::SetNextWindowSize(ImVec2(panel_w, panel_h));
   ImGui::Begin("hysim", nullptr,
@@ -97,6 +97,7 @@ void drawPanel(const engine::Scene& scene, const engine::Simulation& sim, Panel&
   ImGui::Text("scope        %s", path);
   if (gamepad.active()) gamepad.drawPanel();
   recording.drawPanel();
+  store.drawPanel();
   ImGui::Separator();
   drawControls(panel);
   if (panel.details) {

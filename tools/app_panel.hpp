@@ -8,6 +8,7 @@
 #include "app_guidance_panel.hpp"
 #include "app_haptics.hpp"
 #include "app_recording.hpp"
+#include "app_session_store.hpp"
 #include "hysim/engine/scene.hpp"
 #include "hysim/engine/simulation.hpp"
 
@@ -41,6 +42,7 @@ struct FrameNumbers {
 // The whole panel at the window's left edge, panel_w x panel_h screen coordinates.
 void drawPanel(const engine::Scene& scene, const engine::Simulation& sim, Panel& panel, const FrameNumbers& n,
                const GuidanceView& guidance, AppHaptics& force_feedback, const AppGamepad& gamepad,
-               const AppRecording& recording, double path_end_s, float panel_w, float panel_h);
+               const AppRecording& recording, const AppSessionStore& store, double path_end_s, float panel_w,
+               float panel_h);
 
 }  // namespace hysim::tools

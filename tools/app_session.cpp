@@ -17,6 +17,8 @@ Status startSession(Session& s, const engine::Scene& scene, const std::string& r
   }
   s.monitor = std::make_unique<SessionMonitor>(&s.log);
   s.log.write(0.0, "session_start", {{"scene", scene.name}, {"recording", s.recording.path()}});
+  s.hands_on = false;
+  if (s.store != nullptr) s.store->begin(scene, s.recording.path());
   return Status::Ok();
 }
 
@@ -29,6 +31,7 @@ void endSession(Session& s) {
                {"perforations", g.perforations}, {"alarms", s.monitor->alarm().raised()}});
   s.log.close();
   s.recording.finish();
+  if (s.store != nullptr) s.store->finish(s.sim->scene(), g, s.hands_on);
 }
 
 GuidanceView guidanceView(Session& s, AlarmSound& sound, Eigen::Matrix<double, Eigen::Dynamic, 3>& wire) {

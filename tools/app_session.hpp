@@ -11,6 +11,7 @@
 #include "app_monitor.hpp"
 #include "app_recording.hpp"
 #include "app_session_log.hpp"
+#include "app_session_store.hpp"
 #include "hysim/engine/simulation.hpp"
 #include "hysim/haptics/pivot_device.hpp"
 
@@ -22,6 +23,8 @@ struct Session {
   SessionLog log;
   std::unique_ptr<SessionMonitor> monitor;
   haptics::PivotScopeDevice* scope = nullptr;  // the keyboard scope, owned by sim while in use
+  bool hands_on = false;                        // the trainee took the scope during the session
+  AppSessionStore* store = nullptr;             // where sessions are stored (not owned)
 };
 
 // A fresh simulation, recorded into `record_path` (empty: a new file in the recordings folder)

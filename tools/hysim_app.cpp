@@ -14,6 +14,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -67,6 +68,8 @@ struct AppArgs {
   bool paused = false;
   tools::GamepadArgs gamepad;
   std::string record;  // the session's recording; empty: a new file in the recordings folder
+  std::string trainee;   // whose sessions are stored; empty: $USER, else "trainee"
+  std::string data_dir;  // the sessions' data folder; empty: the default
 };
 
 // Median of the last kWindow step times, without allocating per frame.
@@ -240,7 +243,11 @@ int runApp(const AppArgs& args) {
   const std::string scene_path = args.scene.empty() ? tools::defaultScenePath() : args.scene;
   auto scene = engine::loadScene(scene_path);
   if (!scene.ok()) return fail(scene.error());
+  tools::AppSessionStore store;
+  const char* user = std::getenv("USER");
+  store.configure(args.data_dir, !args.trainee.empty() ? args.trainee : (user != nullptr ? user : ""));
   tools::Session session;
+  session.store = &store;
   if (Status s = tools::startSession(session, *scene, args.record); !s.ok()) return fail(s.error());
   tools::AppGamepad gamepad;  // before the window: a missing pad or a bad mapping file stops here
   if (Status s = gamepad.configure(args.gamepad); !s.ok()) return fail(s.error());
@@ -320,6 +327,7 @@ int runApp(const AppArgs& args) {
     engine::Simulation& sim = *session.sim;
 
     if (panel.manual_requested) session.scope = toggleManual(sim, *scene, panel, gamepad);
+    session.hands_on = session.hands_on || panel.manual || gamepad.active();
     gamepad.update(sim, scene->safety.perforation_margin_mm, panel.lens_index,
                    session.monitor->alarm().active(sim.state().time));
     if (session.scope != nullptr) {
@@ -359,8 +367,8 @@ int runApp(const AppArgs& args) {
     (*layer)->newFrame();
     const tools::GuidanceView guidance = tools::guidanceView(session, sound, wire);
     tools::FrameNumbers numbers{step_times.median(), StepTimes::kWindow, realtime, frame_ms, pacer.behind_s, tool_force_n, max_force_n};
-    tools::drawPanel(*scene, sim, panel, numbers, guidance, force_feedback, gamepad, session.recording, path_end_s, panel_w,
-              static_cast<float>(wh));
+    tools::drawPanel(*scene, sim, panel, numbers, guidance, force_feedback, gamepad, session.recording, store, path_end_s,
+                     panel_w, static_cast<float>(wh));
     tools::drawViewOverlay(guidance, view, seconds(now - start));
     (*layer)->render();
 
@@ -412,6 +420,9 @@ int main(int argc, char** argv) {
       ->check(CLI::ExistingFile);
   app.add_flag("--virtual-pad", args.gamepad.virtual_pad,
                "Attach a software game controller (no input; shows the controller panel without a pad)");
+  app.add_option("--trainee", args.trainee, "Store the sessions as this trainee's (default: $USER)");
+  app.add_option("--data-dir", args.data_dir,
+                 "The sessions' data folder (default: $HYSIM_DATA_DIR, $XDG_DATA_HOME/hysim or ~/.local/share/hysim)");
   app.add_option("--record", args.record,
                  "Record the session into this file (default: a new file in the recordings folder, "
                  "$HYSIM_DATA_DIR or ~/.local/share/hysim, /recordings)");
