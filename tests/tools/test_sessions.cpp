@@ -39,10 +39,15 @@ void finishWithOutcome(SessionStore& store, SessionRecord& r) {
   ASSERT_TRUE(store.finish(r).ok());
 }
 
+// An empty data folder of the running test's own.
+std::string freshData() {
+  const fs::path data = testing::testDir("Sessions") / "data";
+  fs::remove_all(data);
+  return data.string();
+}
+
 TEST(Sessions, FileThenRowAndTheOutcomeOnFinish) {
-  const fs::path dir = testing::testDir("Sessions");
-  fs::remove_all(dir / "data");
-  SessionStore store((dir / "data").string());
+  SessionStore store(freshData());
   ASSERT_TRUE(store.open().ok());
   SessionRecord a = sample("Ann");
   ASSERT_TRUE(store.begin(a).ok());
@@ -73,8 +78,7 @@ TEST(Sessions, FileThenRowAndTheOutcomeOnFinish) {
 }
 
 TEST(Sessions, CorruptDatabaseLosesNoSessionAndIsRebuiltFromTheFiles) {
-  const fs::path dir = testing::testDir("Sessions");
-  fs::remove_all(dir / "data");
+  const fs::path dir = fs::path(freshData()).parent_path();
   {
     SessionStore store((dir / "data").string());
     ASSERT_TRUE(store.open().ok());
@@ -104,9 +108,7 @@ TEST(Sessions, CorruptDatabaseLosesNoSessionAndIsRebuiltFromTheFiles) {
 }
 
 TEST(Sessions, LockedDatabaseIsAnErrorAndTheRowFollowsLater) {
-  const fs::path dir = testing::testDir("Sessions");
-  fs::remove_all(dir / "data");
-  SessionStore store((dir / "data").string());
+  SessionStore store(freshData());
   ASSERT_TRUE(store.open().ok());
   sqlite3* other = nullptr;
   ASSERT_EQ(sqlite3_open(store.databasePath().c_str(), &other), SQLITE_OK);
