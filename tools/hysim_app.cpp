@@ -34,6 +34,8 @@
 #include "app_recording.hpp"
 #include "app_session.hpp"
 #include "app_session_log.hpp"
+#include "app_start_screen.hpp"
+#include "app_cases.hpp"
 #include "tool_common.hpp"
 #include "hysim/engine/scene.hpp"
 #include "hysim/engine/simulation.hpp"
@@ -239,32 +241,57 @@ void reportAlarmFrame(const engine::Simulation& sim, const tools::SessionMonitor
   std::printf("hysim-app: alarm screenshot %s\n", screenshot.c_str());
 }
 
-int runApp(const AppArgs& args) {
-  const std::string scene_path = args.scene.empty() ? tools::defaultScenePath() : args.scene;
+// The window and its ImGui layer, made before any scene: the start screen draws in them too.
+struct AppWindow {
+  std::unique_ptr<render::SdlWindow> window;
+  std::unique_ptr<render::ImGuiLayer> layer;
+};
+
+Result<AppWindow> openWindow(const AppArgs& args) {
+  render::SdlWindowOptions options;
+  options.title = "hysim";
+  options.width = args.width;
+  options.height = args.height;
+  options.vsync = !args.no_vsync;
+  auto window = render::SdlWindow::create(options);
+  if (!window.ok()) return Error{window.error()};
+  auto layer = render::ImGuiLayer::create(**window);
+  if (!layer.ok()) return Error{layer.error()};
+  return AppWindow{std::move(window.value()), std::move(layer.value())};
+}
+
+// The scene to run: the command line's, else the case the trainee starts on the start screen
+// (empty: the trainee quit there). The start screen also sets the mode and the trainee's name.
+std::string chooseScene(const AppArgs& args, AppWindow& w, bool& hands_on, std::string& trainee) {
+  if (!args.scene.empty()) return args.scene;
+  const std::vector<tools::CaseInfo> cases = tools::listCases(fs::path(tools::defaultScenePath()).parent_path().string());
+  const tools::StartChoice choice =
+      tools::runStartScreen(*w.window, *w.layer, cases, trainee, {args.quit_after_s, args.frames, args.screenshot});
+  if (choice.quit) return {};
+  hands_on = choice.hands_on;
+  if (!choice.trainee.empty()) trainee = choice.trainee;
+  return cases[choice.index].path;
+}
+
+// One case, from its scene to the trainee quitting (sessions begin anew on each reset).
+int runCase(const AppArgs& args, const std::string& scene_path, bool hands_on, const std::string& trainee,
+            AppWindow& w) {
   auto scene = engine::loadScene(scene_path);
   if (!scene.ok()) return fail(scene.error());
   tools::AppSessionStore store;
-  const char* user = std::getenv("USER");
-  store.configure(args.data_dir, !args.trainee.empty() ? args.trainee : (user != nullptr ? user : ""));
+  store.configure(args.data_dir, trainee);
   tools::Session session;
   session.store = &store;
   if (Status s = tools::startSession(session, *scene, args.record); !s.ok()) return fail(s.error());
-  tools::AppGamepad gamepad;  // before the window: a missing pad or a bad mapping file stops here
+  tools::AppGamepad gamepad;  // a missing pad or a bad mapping file stops here
   if (Status s = gamepad.configure(args.gamepad); !s.ok()) return fail(s.error());
-
-  render::SdlWindowOptions window_options;
-  window_options.title = "hysim - " + scene->name;
-  window_options.width = args.width;
-  window_options.height = args.height;
-  window_options.vsync = !args.no_vsync;
-  auto window = render::SdlWindow::create(window_options);
-  if (!window.ok()) return fail(window.error());
+  std::unique_ptr<render::SdlWindow>& window = w.window;
+  std::unique_ptr<render::ImGuiLayer>& layer = w.layer;
+  SDL_SetWindowTitle(window->nativeWindow(), ("hysim - " + scene->name).c_str());
   auto renderer = render::Renderer::create(scene->render.width, scene->render.height);
   if (!renderer.ok()) return fail("cannot create the renderer: " + renderer.error());
-  auto layer = render::ImGuiLayer::create(**window);
-  if (!layer.ok()) return fail(layer.error());
   std::printf("hysim-app: scene %s (%s); %s\n", scene->name.c_str(), scene_path.c_str(),
-              (*window)->description().c_str());
+              window->description().c_str());
   tools::AlarmSound sound;
   sound.open();
 
@@ -283,7 +310,7 @@ int runApp(const AppArgs& args) {
   const double path_end_s = haptics::Trajectory(scene->tool_path).duration();
 
   tools::AppHaptics force_feedback;
-  panel.manual_requested = gamepad.enabled();  // the pad takes the tool at the first frame
+  panel.manual_requested = gamepad.enabled() || hands_on;  // the pad or the keyboard takes the tool at once
 
   const Clock::time_point start = Clock::now();
   Clock::time_point last = start;
@@ -296,10 +323,10 @@ int runApp(const AppArgs& args) {
     // frame, so --screenshot always gets a complete last frame.
     SDL_Event event;
     while (SDL_PollEvent(&event)) {
-      const bool taken = (*layer)->processEvent(event);
+      const bool taken = layer->processEvent(event);
       if (event.type == SDL_QUIT) quit = true;
       if (event.type == SDL_WINDOWEVENT && event.window.event == SDL_WINDOWEVENT_CLOSE &&
-          event.window.windowID == SDL_GetWindowID((*window)->nativeWindow())) {
+          event.window.windowID == SDL_GetWindowID(window->nativeWindow())) {
         quit = true;
       }
       if (event.type == SDL_KEYDOWN && !taken && event.key.repeat == 0) {
@@ -359,31 +386,31 @@ int runApp(const AppArgs& args) {
     (*renderer)->draw(snapshot);
 
     const float panel_w = 300.0f;  // screen coordinates
-    const tools::ViewRect view = blitView(**window, **renderer, panel_w);
+    const tools::ViewRect view = blitView(*window, **renderer, panel_w);
     int ww = 0, wh = 0;
-    SDL_GetWindowSize((*window)->nativeWindow(), &ww, &wh);
+    SDL_GetWindowSize(window->nativeWindow(), &ww, &wh);
 
     // The panel and the view's overlay.
-    (*layer)->newFrame();
+    layer->newFrame();
     const tools::GuidanceView guidance = tools::guidanceView(session, sound, wire);
     tools::FrameNumbers numbers{step_times.median(), StepTimes::kWindow, realtime, frame_ms, pacer.behind_s, tool_force_n, max_force_n};
     tools::drawPanel(*scene, sim, panel, numbers, guidance, force_feedback, gamepad, session.recording, store, path_end_s,
                      panel_w, static_cast<float>(wh));
     tools::drawViewOverlay(guidance, view, seconds(now - start));
-    (*layer)->render();
+    layer->render();
 
     ++frame;
     if (alarm_raised && !alarm_shot_done) {
       alarm_shot_done = true;
       reportAlarmFrame(sim, *session.monitor, seconds(Clock::now() - alarm_step_wall), args.alarm_screenshot,
-                       **window);
+                       *window);
     }
     if (quit && !args.screenshot.empty()) {
-      const render::Image shot = (*window)->readBackBuffer();
+      const render::Image shot = window->readBackBuffer();
       if (Status s = render::writePng(args.screenshot, shot); !s.ok()) return fail(s.error());
       std::printf("hysim-app: screenshot %s (%dx%d)\n", args.screenshot.c_str(), shot.width, shot.height);
     }
-    (*window)->swapBuffers();
+    window->swapBuffers();
     if (quit) break;
   }
   const engine::Simulation& sim = *session.sim;
@@ -394,6 +421,17 @@ int runApp(const AppArgs& args) {
               frame, sim.state().time, static_cast<unsigned long long>(sim.state().steps), sim.state().warnings,
               sim.perforations(), alarms, engine::hashHex(sim.stateHash()).c_str());
   return 0;
+}
+
+int runApp(const AppArgs& args) {
+  auto opened = openWindow(args);
+  if (!opened.ok()) return fail(opened.error());
+  const char* user = std::getenv("USER");
+  std::string trainee = !args.trainee.empty() ? args.trainee : (user != nullptr ? user : "");
+  bool hands_on = false;
+  const std::string scene_path = chooseScene(args, *opened, hands_on, trainee);
+  if (scene_path.empty()) return 0;
+  return runCase(args, scene_path, hands_on, trainee, *opened);
 }
 
 }  // namespace
