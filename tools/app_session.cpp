@@ -17,8 +17,7 @@ Status startSession(Session& s, const engine::Scene& scene, const std::string& r
   }
   s.monitor = std::make_unique<SessionMonitor>(&s.log);
   s.log.write(0.0, "session_start", {{"scene", scene.name}, {"recording", s.recording.path()}});
-  s.hands_on = false;
-  if (s.store != nullptr) s.store->begin(scene, s.recording.path());
+  if (s.store != nullptr) s.store->begin(scene, s.recording.path(), s.hands_on);
   return Status::Ok();
 }
 

@@ -23,7 +23,7 @@ struct Session {
   SessionLog log;
   std::unique_ptr<SessionMonitor> monitor;
   haptics::PivotScopeDevice* scope = nullptr;  // the keyboard scope, owned by sim while in use
-  bool hands_on = false;                        // the trainee took the scope during the session
+  bool hands_on = false;                        // hands-on mode, or the trainee took the scope
   AppSessionStore* store = nullptr;             // where sessions are stored (not owned)
 };
 

@@ -20,13 +20,13 @@ void AppSessionStore::note(const Status& st) {
   std::printf("hysim-app: %s\n", problem_.c_str());
 }
 
-void AppSessionStore::begin(const engine::Scene& scene, const std::string& recording) {
+void AppSessionStore::begin(const engine::Scene& scene, const std::string& recording, bool hands_on) {
   if (!store_) return;
   record_ = SessionRecord{};
   record_.trainee = trainee_;
   record_.case_name = scene.name;
   record_.scene = scene.path;
-  record_.mode = "demo";
+  record_.mode = hands_on ? "hands-on" : "demo";
   record_.recording = recording;
   note(store_->begin(record_));
   open_ = !record_.file.empty();

@@ -16,7 +16,7 @@ class AppSessionStore {
   // The data folder (empty: defaultDataFolder()) and the trainee's name, for every session.
   void configure(const std::string& data_dir, const std::string& trainee);
   // Begins a stored session of `scene` (its recording at `recording`, if any).
-  void begin(const engine::Scene& scene, const std::string& recording);
+  void begin(const engine::Scene& scene, const std::string& recording, bool hands_on);
   // Ends it with the session's numbers, assessed against the scene's thresholds.
   void finish(const engine::Scene& scene, const GuidanceNumbers& numbers, bool hands_on);
   // The trainee, the last finished session's score, and any problem, in the panel.

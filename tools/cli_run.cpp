@@ -34,6 +34,7 @@ extern "C" void requestStop(int) { g_stop_requested.store(true); }
 void stopOnInterrupt(engine::RunOptions& options) {
   struct sigaction action {};
   action.sa_handler = requestStop;
+  action.sa_flags = SA_RESETHAND | SA_RESTART;  // a second Ctrl-C ends a run that does not stop
   sigemptyset(&action.sa_mask);
   sigaction(SIGINT, &action, nullptr);
   sigaction(SIGTERM, &action, nullptr);

@@ -53,6 +53,7 @@ std::shared_ptr<SessionsCommands> addSessionsCommands(CLI::App& app) {
   auto c = std::make_shared<SessionsCommands>();
   c->sessions = app.add_subcommand("sessions", "Trainee sessions stored in the data folder (list, export)");
   c->sessions->require_subcommand(1);
+  c->sessions->fallthrough();  // `sessions list --trainee X` as well as `sessions --trainee X list`
   c->sessions->add_option("--data-dir", c->args.data_dir,
                           "Data folder (default: $HYSIM_DATA_DIR, $XDG_DATA_HOME/hysim or ~/.local/share/hysim)");
   c->sessions->add_option("--trainee", c->args.trainee, "Only this trainee's sessions");

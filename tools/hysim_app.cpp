@@ -278,18 +278,19 @@ int runCase(const AppArgs& args, const std::string& scene_path, bool hands_on, c
             AppWindow& w) {
   auto scene = engine::loadScene(scene_path);
   if (!scene.ok()) return fail(scene.error());
+  tools::AppGamepad gamepad;  // a missing pad or a bad mapping file stops here, before a session
+  if (Status s = gamepad.configure(args.gamepad); !s.ok()) return fail(s.error());
+  auto renderer = render::Renderer::create(scene->render.width, scene->render.height);
+  if (!renderer.ok()) return fail("cannot create the renderer: " + renderer.error());
   tools::AppSessionStore store;
   store.configure(args.data_dir, trainee);
   tools::Session session;
   session.store = &store;
+  session.hands_on = hands_on;
   if (Status s = tools::startSession(session, *scene, args.record); !s.ok()) return fail(s.error());
-  tools::AppGamepad gamepad;  // a missing pad or a bad mapping file stops here
-  if (Status s = gamepad.configure(args.gamepad); !s.ok()) return fail(s.error());
   std::unique_ptr<render::SdlWindow>& window = w.window;
   std::unique_ptr<render::ImGuiLayer>& layer = w.layer;
   SDL_SetWindowTitle(window->nativeWindow(), ("hysim - " + scene->name).c_str());
-  auto renderer = render::Renderer::create(scene->render.width, scene->render.height);
-  if (!renderer.ok()) return fail("cannot create the renderer: " + renderer.error());
   std::printf("hysim-app: scene %s (%s); %s\n", scene->name.c_str(), scene_path.c_str(),
               window->description().c_str());
   tools::AlarmSound sound;
@@ -317,6 +318,7 @@ int runCase(const AppArgs& args, const std::string& scene_path, bool hands_on, c
   long frame = 0;
   bool quit = false;
   bool alarm_raised = false, alarm_shot_done = false;  // the session's first alarm, for --alarm-screenshot
+  bool screenshot_failed = false;
   Clock::time_point alarm_step_wall;
   while (true) {
     // Events. Every way out (Esc, window close, --frames, --quit-after-s) still draws this
@@ -343,9 +345,10 @@ int runCase(const AppArgs& args, const std::string& scene_path, bool hands_on, c
     if (panel.reset_requested) {
       panel.reset_requested = false;
       tools::endSession(session);  // a reset starts a new session, recorded and logged anew
+      session.hands_on = hands_on;
       if (Status s = tools::startSession(session, *scene, ""); !s.ok()) return fail("reset: " + s.error());
       gamepad.release();    // (the pad's device went with the old simulation)
-      panel.manual_requested = gamepad.enabled();
+      panel.manual_requested = gamepad.enabled() || hands_on;
       panel.manual = false;
       pacer.reset();
       step_times.clear();
@@ -405,10 +408,14 @@ int runCase(const AppArgs& args, const std::string& scene_path, bool hands_on, c
       reportAlarmFrame(sim, *session.monitor, seconds(Clock::now() - alarm_step_wall), args.alarm_screenshot,
                        *window);
     }
-    if (quit && !args.screenshot.empty()) {
+    if (quit && !args.screenshot.empty()) {  // (a failure is said; the session still ends below)
       const render::Image shot = window->readBackBuffer();
-      if (Status s = render::writePng(args.screenshot, shot); !s.ok()) return fail(s.error());
-      std::printf("hysim-app: screenshot %s (%dx%d)\n", args.screenshot.c_str(), shot.width, shot.height);
+      if (Status s = render::writePng(args.screenshot, shot); !s.ok()) {
+        screenshot_failed = true;
+        std::cerr << "hysim-app: " << s.error() << "\n";
+      } else {
+        std::printf("hysim-app: screenshot %s (%dx%d)\n", args.screenshot.c_str(), shot.width, shot.height);
+      }
     }
     window->swapBuffers();
     if (quit) break;
@@ -420,7 +427,7 @@ int runCase(const AppArgs& args, const std::string& scene_path, bool hands_on, c
               "state_hash %s\n",
               frame, sim.state().time, static_cast<unsigned long long>(sim.state().steps), sim.state().warnings,
               sim.perforations(), alarms, engine::hashHex(sim.stateHash()).c_str());
-  return 0;
+  return screenshot_failed ? 1 : 0;
 }
 
 int runApp(const AppArgs& args) {

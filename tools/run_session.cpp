@@ -34,7 +34,7 @@ void finishRunSession(const engine::RunReport& report, RunSession& session) {
   r.electrode_active_s = s.electrode_active_s;
   r.passes = s.passes;
   r.score = s.assessment.score;
-  r.passed = s.assessment.passed;
+  r.passed = s.assessment.passed && !report.partial;  // a run stopped early passes nothing
   if (Status st = session.store->finish(r, !report.partial); !st.ok()) std::cerr << "hysim: " << st.error() << "\n";
 }
 

@@ -1,6 +1,7 @@
 #include "session_store.hpp"
 
 #include <sqlite3.h>
+#include <unistd.h>
 
 #include <chrono>
 #include <cstdlib>
@@ -76,7 +77,9 @@ std::string newSessionFile(const fs::path& dir, const SessionRecord& r) {
   std::string stamp;
   for (const char c : r.started_utc)
     if (c >= '0' && c <= '9') stamp += c;
-  const std::string base = stamp + "-" + namePart(r.trainee) + "-" + namePart(r.case_name);
+  // (The process id keeps two sessions begun in the same second by two programs apart.)
+  const std::string base =
+      stamp + "-" + namePart(r.trainee) + "-" + namePart(r.case_name) + "-" + std::to_string(::getpid());
   fs::path p = dir / (base + ".json");
   for (int k = 2; fs::exists(p); ++k) p = dir / (base + "-" + std::to_string(k) + ".json");
   return p.string();
@@ -189,13 +192,14 @@ Status SessionStore::open() {
     return e;
   }
   sqlite3_busy_timeout(db_, 2000);  // another hysim writing: wait a little, then say it is locked
-  Status st = exec(kSchema);
-  if (st.ok()) st = addMissingRows();
-  if (!st.ok()) {
+  if (Status st = exec(kSchema); !st.ok()) {
     sqlite3_close(db_);
     db_ = nullptr;
+    return st;
   }
-  return st;
+  // Rows that could not be recovered now (e.g. another process holds the lock) are recovered
+  // by a later open; the database stays usable meanwhile.
+  return addMissingRows();
 }
 
 Status SessionStore::writeFile(const SessionRecord& r) const {
@@ -214,11 +218,17 @@ Status SessionStore::upsertRow(SessionRecord& r) {
   if (!s.ok()) return databaseError("cannot prepare the session row");
   bindRecord(s, r);
   if (sqlite3_step(s.get()) != SQLITE_ROW) return databaseError("cannot write the session row");
-  r.id = sqlite3_column_int64(s.get(), 0);
+  const long long id = sqlite3_column_int64(s.get(), 0);
+  // With RETURNING the row is committed when the statement runs to its end, which can fail.
+  if (sqlite3_step(s.get()) != SQLITE_DONE) return databaseError("cannot write the session row");
+  r.id = id;
   return Status::Ok();
 }
 
 Status SessionStore::addMissingRows() {
+  // The folder is read inside the write transaction: a session finished by another process
+  // meanwhile cannot be overwritten by what its file said before.
+  if (Status st = exec("BEGIN IMMEDIATE"); !st.ok()) return st;
   std::vector<SessionRecord> files;
   std::error_code ec;
   for (const auto& entry : fs::directory_iterator(fs::path(folder_) / "sessions", ec)) {
@@ -226,8 +236,10 @@ Status SessionStore::addMissingRows() {
     auto r = readSessionFile(entry.path().string());
     if (r.ok()) files.push_back(*r);  // (an unreadable file is skipped, never deleted)
   }
-  if (ec) return Error{"cannot list the session folder: " + ec.message()};
-  if (Status st = exec("BEGIN"); !st.ok()) return st;
+  if (ec) {
+    (void)exec("ROLLBACK");
+    return Error{"cannot list the session folder: " + ec.message()};
+  }
   for (SessionRecord& r : files) {
     if (Status st = upsertRow(r); !st.ok()) {
       (void)exec("ROLLBACK");
