@@ -273,6 +273,17 @@ std::string chooseScene(const AppArgs& args, AppWindow& w, bool& hands_on, std::
   return cases[choice.index].path;
 }
 
+// Ends the session (stored, logged) and prints its last line.
+void endAndPrint(tools::Session& session, long frames) {
+  const engine::Simulation& sim = *session.sim;
+  const int alarms = session.monitor->alarm().raised();
+  tools::endSession(session);
+  std::printf("hysim-app: %ld frames, sim time %.3f s, %llu steps, warnings %d, perforations %d, alarms %d, "
+              "state_hash %s\n",
+              frames, sim.state().time, static_cast<unsigned long long>(sim.state().steps), sim.state().warnings,
+              sim.perforations(), alarms, engine::hashHex(sim.stateHash()).c_str());
+}
+
 // One case, from its scene to the trainee quitting (sessions begin anew on each reset).
 int runCase(const AppArgs& args, const std::string& scene_path, bool hands_on, const std::string& trainee,
             AppWindow& w) {
@@ -420,13 +431,7 @@ int runCase(const AppArgs& args, const std::string& scene_path, bool hands_on, c
     window->swapBuffers();
     if (quit) break;
   }
-  const engine::Simulation& sim = *session.sim;
-  const int alarms = session.monitor->alarm().raised();
-  tools::endSession(session);
-  std::printf("hysim-app: %ld frames, sim time %.3f s, %llu steps, warnings %d, perforations %d, alarms %d, "
-              "state_hash %s\n",
-              frame, sim.state().time, static_cast<unsigned long long>(sim.state().steps), sim.state().warnings,
-              sim.perforations(), alarms, engine::hashHex(sim.stateHash()).c_str());
+  endAndPrint(session, frame);
   return screenshot_failed ? 1 : 0;
 }
 
