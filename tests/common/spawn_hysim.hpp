@@ -6,7 +6,10 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <chrono>
+#include <filesystem>
 #include <string>
+#include <thread>
 #include <vector>
 
 namespace hysim::testing {
@@ -34,6 +37,18 @@ inline int waitStatus(pid_t pid) {
   int status = 0;
   if (waitpid(pid, &status, 0) != pid) return -1;
   return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+}
+
+// Waits (at most 60 s) until `dir` holds a file ending in `extension` (a run's session file,
+// not only its temporary): the run has got that far.
+inline bool waitForFileEndingIn(const std::filesystem::path& dir, const std::string& extension) {
+  for (int i = 0; i < 600; ++i) {
+    std::error_code ec;
+    for (const auto& e : std::filesystem::directory_iterator(dir, ec))
+      if (e.path().extension() == extension) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  return false;
 }
 
 }  // namespace hysim::testing

@@ -20,18 +20,6 @@ namespace {
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 
-// Waits (at most 60 s) until `dir` holds a session file (not only its temporary): the run has
-// begun its session.
-bool waitForASessionFile(const fs::path& dir) {
-  for (int i = 0; i < 600; ++i) {
-    std::error_code ec;
-    for (const auto& e : fs::directory_iterator(dir, ec))
-      if (e.path().extension() == ".json") return true;
-    std::this_thread::sleep_for(std::chrono::milliseconds(100));
-  }
-  return false;
-}
-
 std::vector<fs::path> sessionFiles(const fs::path& data) {
   std::vector<fs::path> out;
   std::error_code ec;
@@ -47,7 +35,7 @@ TEST(InterruptedRun, SigintAndSigtermWriteAPartialReport) {
     const pid_t pid = testing::spawnHysim(
         {"run", "--quiet", "--report", report, "--trainee", "Cleo", "--data-dir", (dir / "data").string()});
     ASSERT_GT(pid, 0);
-    ASSERT_TRUE(waitForASessionFile(dir / "data" / "sessions"));
+    ASSERT_TRUE(testing::waitForFileEndingIn(dir / "data" / "sessions", ".json"));
     std::this_thread::sleep_for(std::chrono::milliseconds(500));
     kill(pid, signal);
     EXPECT_EQ(testing::waitStatus(pid), 4) << "signal " << signal;

@@ -186,12 +186,7 @@ TEST(SessionsCli, KilledRunIsListedIncomplete) {
   const pid_t pid = testing::spawnHysim({"run", "--quiet", "--trainee", "Bob", "--data-dir", data});
   ASSERT_GT(pid, 0);
   const fs::path sessions = fs::path(data) / "sessions";
-  bool begun = false;
-  for (int i = 0; i < 600 && !begun; ++i) {  // until the session's file is there (at most 60 s)
-    std::this_thread::sleep_for(std::chrono::milliseconds(100));
-    std::error_code ec;
-    for (const auto& e : fs::directory_iterator(sessions, ec)) begun = begun || e.path().extension() == ".json";
-  }
+  const bool begun = testing::waitForFileEndingIn(sessions, ".json");
   std::this_thread::sleep_for(std::chrono::milliseconds(300));
   kill(pid, SIGKILL);
   const int status = testing::waitStatus(pid);
