@@ -22,6 +22,7 @@ struct Panel {
   bool manual = false;  // keyboard drives the scope instead of the scripted path
   bool manual_requested = false;
   bool details = false;  // developer numbers (step time, substeps, forces) shown
+  bool hidden = false;   // the panel is collapsed: the scope view takes the whole window
 };
 
 inline constexpr std::array<int, 3> kLens = {0, 12, 30};  // degrees

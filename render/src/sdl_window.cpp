@@ -6,6 +6,7 @@
 #include <epoxy/gl.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <cstdlib>
 
 namespace hysim::render {
@@ -117,7 +118,27 @@ hysim::Status SdlWindow::makeCurrent() {
   return hysim::Status::Ok();
 }
 
-void SdlWindow::swapBuffers() { SDL_GL_SwapWindow(window_); }
+void SdlWindow::swapBuffers() {
+  std::string path;
+  {
+    std::lock_guard<std::mutex> lock(capture_mutex_);
+    path.swap(capture_path_);
+  }
+  if (!path.empty()) {
+    const Image shot = readBackBuffer();
+    if (Status s = writePng(path, shot); !s.ok()) {
+      std::fprintf(stderr, "hysim: %s\n", s.error().c_str());
+    } else {
+      std::printf("hysim: frame captured in %s (%dx%d)\n", path.c_str(), shot.width, shot.height);
+    }
+  }
+  SDL_GL_SwapWindow(window_);
+}
+
+void SdlWindow::captureNextFrame(const std::string& png_path) {
+  std::lock_guard<std::mutex> lock(capture_mutex_);
+  capture_path_ = png_path;
+}
 
 void SdlWindow::clear(float r, float g, float b) {
   int w = 0, h = 0;

@@ -7,6 +7,7 @@
 // SDL types stay out of this header (apps that only show a frame do not need SDL's
 // headers); nativeWindow()/glContext() hand them out for ImGui's backends and event code.
 #include <memory>
+#include <mutex>
 #include <string>
 
 #include "hysim/cutting/result.hpp"
@@ -42,7 +43,11 @@ class SdlWindow {
   SdlWindow& operator=(const SdlWindow&) = delete;
 
   hysim::Status makeCurrent();
+  // Shows the back buffer; first writes it as a PNG when a capture was asked for.
   void swapBuffers();
+  // The next swapBuffers writes the frame it shows to `png_path` (from any thread: scripted
+  // input asks for pictures while whatever screen is up draws).
+  void captureNextFrame(const std::string& png_path);
   // Binds the default framebuffer, sets the viewport to the drawable and clears it.
   void clear(float r, float g, float b);
   // Size of the default framebuffer in pixels (differs from the window size on HiDPI).
@@ -61,6 +66,8 @@ class SdlWindow {
   SDL_Window* window_ = nullptr;
   void* context_ = nullptr;
   std::string description_;
+  std::mutex capture_mutex_;
+  std::string capture_path_;  // under capture_mutex_; empty: none asked for
 };
 
 }  // namespace hysim::render
