@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cstdio>
 #include <iostream>
+#include <thread>
 
 #include "app_beep.hpp"
 #include "app_frame_stats.hpp"
@@ -264,9 +265,10 @@ void sayWhenBehind(CaseLoop& c, const engine::PaceStats& pace, const ViewRect& v
     std::printf("hysim-app: this computer cannot keep up with real time; the simulation runs slower (%.2fx so far)\n",
                 pace.wall_s > 0.0 ? pace.sim_s / pace.wall_s : 0.0);
   }
-  ImGui::GetForegroundDrawList()->AddText(ImVec2(view.min.x + 12.0f, view.max.y - 28.0f),
-                                          IM_COL32(255, 190, 80, 255),
-                                          "This computer cannot keep up: the simulation runs slower than real time");
+  const char* text = "This computer cannot keep up: the simulation runs slower than real time";
+  const float width = ImGui::CalcTextSize(text).x;
+  ImGui::GetForegroundDrawList()->AddText(ImVec2(std::max(view.min.x, view.max.x - width - 12.0f), view.min.y + 8.0f),
+                                          IM_COL32(255, 190, 80, 255), text);
 }
 
 // The panel and the view's overlay, drawn between two steps.
@@ -332,6 +334,10 @@ Status runFrame(CaseLoop& c) {
   if (alarm_now) reportAlarmFrame(c);
   if (c.quit && !c.options.screenshot.empty() && !writeScreenshot(c)) c.screenshot_failed = true;
   c.w.window->swapBuffers();
+  if (c.options.max_fps > 0.0) {
+    std::this_thread::sleep_until(now + std::chrono::duration_cast<Clock::duration>(
+                                            std::chrono::duration<double>(1.0 / c.options.max_fps)));
+  }
   return {};
 }
 

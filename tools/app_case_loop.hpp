@@ -29,6 +29,9 @@ struct CaseOptions {
   std::string trainee;   // whose sessions are stored
   std::string data_dir;  // the sessions' data folder; empty: the default
   bool hands_on = false;
+  // Frames per second at most (0: as many as the machine draws): a software GL would otherwise
+  // draw as fast as it can and take the simulation thread's core.
+  double max_fps = 40.0;
   InputPlayer* input = nullptr;  // scripted input, whose sim events the frame loop plays; null: none
 };
 

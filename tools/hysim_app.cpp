@@ -42,6 +42,7 @@ struct AppArgs {
   std::string trainee;   // whose sessions are stored; empty: $USER, else "trainee"
   std::string data_dir;  // the sessions' data folder; empty: the default
   std::string input;     // a scripted input file; empty: none
+  double max_fps = 40.0;
 };
 
 Result<tools::AppWindow> openWindow(const AppArgs& args) {
@@ -95,6 +96,7 @@ int runApp(const AppArgs& args) {
   options.trainee = trainee;
   options.data_dir = args.data_dir;
   options.hands_on = hands_on;
+  options.max_fps = args.max_fps;
   options.input = args.input.empty() ? nullptr : &input;
   return tools::runCase(options, scene_path, *opened);
 }
@@ -131,6 +133,9 @@ int main(int argc, char** argv) {
                  "$HYSIM_DATA_DIR or ~/.local/share/hysim, /recordings)");
   app.add_option("--input", args.input,
                  "Play a scripted input file into the window (timed keys, text, captures; see render/README.md)");
+  app.add_option("--max-fps", args.max_fps, "Draw at most this many frames per second (0: no limit)")
+      ->capture_default_str()
+      ->check(tools::finiteRange(0, 1000));
   CLI11_PARSE(app, argc, argv);
   return runApp(args);
 }
