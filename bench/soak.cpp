@@ -44,7 +44,7 @@ struct Course {
 };
 
 // One course: a fresh simulation, the whole scripted path, a frame every `every` steps.
-Result<Course> runCourse(const engine::Scene& scene, render::Renderer& renderer, int every) {
+Result<Course> runCourse(const engine::Scene& scene, render::OffscreenRenderer& renderer, int every) {
   auto sim = engine::Simulation::create(scene);
   if (!sim.ok()) return Error{sim.error()};
   render::Image frame;
@@ -100,7 +100,7 @@ int main(int argc, char** argv) {
 
   auto scene = engine::loadScene(scene_path);
   if (!scene.ok()) return std::fprintf(stderr, "soak: %s\n", scene.error().c_str()), 1;
-  auto renderer = render::Renderer::create(scene->render.width, scene->render.height);
+  auto renderer = render::OffscreenRenderer::create(scene->render.width, scene->render.height);
   if (!renderer.ok()) return std::fprintf(stderr, "soak: %s\n", renderer.error().c_str()), 1;
   const int every = static_cast<int>(std::lround(1.0 / scene->sim.dt));  // a frame per simulated second
   std::vector<Course> courses;
