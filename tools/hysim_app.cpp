@@ -36,6 +36,10 @@
 #include "app_session_log.hpp"
 #include "app_start_screen.hpp"
 #include "app_cases.hpp"
+#include "app_case_result.hpp"
+#include "app_debrief.hpp"
+#include "app_progress.hpp"
+#include "app_replay.hpp"
 #include "tool_common.hpp"
 #include "hysim/engine/scene.hpp"
 #include "hysim/engine/simulation.hpp"
@@ -148,10 +152,12 @@ tools::TraineeKeys heldKeys() {
   return keys;
 }
 
-// A key the panel did not take. True: quit.
+// A key the panel did not take. True: the case ends (quit, or Enter: to the debrief).
 bool handleKey(SDL_Keycode key, tools::Panel& panel, tools::AppHaptics& force_feedback) {
   switch (key) {
     case SDLK_ESCAPE: return true;
+    case SDLK_RETURN:
+    case SDLK_KP_ENTER: panel.end_requested = true; return true;
     case SDLK_SPACE: panel.paused = !panel.paused; break;
     case SDLK_r: panel.reset_requested = true; break;
     case SDLK_l: panel.lens_index = (panel.lens_index + 1) % 3; break;
@@ -260,21 +266,9 @@ Result<AppWindow> openWindow(const AppArgs& args) {
   return AppWindow{std::move(window.value()), std::move(layer.value())};
 }
 
-// The scene to run: the command line's, else the case the trainee starts on the start screen
-// (empty: the trainee quit there). The start screen also sets the mode and the trainee's name.
-std::string chooseScene(const AppArgs& args, AppWindow& w, bool& hands_on, std::string& trainee) {
-  if (!args.scene.empty()) return args.scene;
-  const std::vector<tools::CaseInfo> cases = tools::listCases(fs::path(tools::defaultScenePath()).parent_path().string());
-  const tools::StartChoice choice =
-      tools::runStartScreen(*w.window, *w.layer, cases, trainee, {args.quit_after_s, args.frames, args.screenshot});
-  if (choice.quit) return {};
-  hands_on = choice.hands_on;
-  if (!choice.trainee.empty()) trainee = choice.trainee;
-  return cases[choice.index].path;
-}
-
-// Ends the session (stored, logged) and prints its last line.
-void endAndPrint(tools::Session& session, long frames) {
+// Ends the session (stored, logged), prints its last line and returns what the debrief shows
+// (`ended`: the trainee ended the case rather than quitting).
+tools::CaseResult endAndPrint(tools::Session& session, long frames, bool ended) {
   const engine::Simulation& sim = *session.sim;
   const int alarms = session.monitor->alarm().raised();
   tools::endSession(session);
@@ -282,11 +276,13 @@ void endAndPrint(tools::Session& session, long frames) {
               "state_hash %s\n",
               frames, sim.state().time, static_cast<unsigned long long>(sim.state().steps), sim.state().warnings,
               sim.perforations(), alarms, engine::hashHex(sim.stateHash()).c_str());
+  return tools::caseResult(session, ended);
 }
 
-// One case, from its scene to the trainee quitting (sessions begin anew on each reset).
+// One case, from its scene to the trainee quitting or ending it (sessions begin anew on each
+// reset); `result` is what the debrief shows.
 int runCase(const AppArgs& args, const std::string& scene_path, bool hands_on, const std::string& trainee,
-            AppWindow& w) {
+            AppWindow& w, tools::CaseResult& result) {
   auto scene = engine::loadScene(scene_path);
   if (!scene.ok()) return fail(scene.error());
   tools::AppGamepad gamepad;  // a missing pad or a bad mapping file stops here, before a session
@@ -352,6 +348,7 @@ int runCase(const AppArgs& args, const std::string& scene_path, bool hands_on, c
     last = now;
     if (args.frames >= 0 && frame + 1 >= args.frames) quit = true;
     if (args.quit_after_s >= 0.0 && seconds(now - start) >= args.quit_after_s) quit = true;
+    if (panel.end_requested) quit = true;
 
     if (panel.reset_requested) {
       panel.reset_requested = false;
@@ -431,19 +428,91 @@ int runCase(const AppArgs& args, const std::string& scene_path, bool hands_on, c
     window->swapBuffers();
     if (quit) break;
   }
-  endAndPrint(session, frame);
+  result = endAndPrint(session, frame, panel.end_requested);
   return screenshot_failed ? 1 : 0;
 }
 
+// Where the trainee is between screens: the start screen's choices, the case, its result.
+struct AppFlow {
+  std::vector<tools::CaseInfo> cases;
+  tools::StartChoice choice;  // the trainee, the case and the mode
+  std::string scene_path;
+  std::string record;         // --record, for the first case only (later ones get new files)
+  tools::CaseResult result;
+  std::string message;        // for the debrief: why the replay could not play
+};
+
+enum class Next { Start, Case, Debrief, Quit };
+
+tools::StartScreenExit screenExit(const AppArgs& args) { return {args.quit_after_s, args.frames, args.screenshot}; }
+
+// The start screen, and the progress screen from it, until a case is chosen or the trainee quits.
+Next startScreen(const AppArgs& args, AppWindow& w, AppFlow& flow) {
+  if (flow.cases.empty()) {
+    flow.cases = tools::listCases(fs::path(tools::defaultScenePath()).parent_path().string());
+  }
+  while (true) {
+    const tools::StartChoice c = tools::runStartScreen(*w.window, *w.layer, flow.cases, flow.choice, screenExit(args));
+    if (!c.trainee.empty()) flow.choice.trainee = c.trainee;
+    flow.choice.index = c.index;
+    flow.choice.hands_on = c.hands_on;
+    if (c.quit) return Next::Quit;
+    if (!c.progress) break;
+    if (!tools::runProgress(*w.window, *w.layer, args.data_dir, flow.choice.trainee, screenExit(args))) {
+      return Next::Quit;
+    }
+  }
+  flow.scene_path = flow.cases[flow.choice.index].path;
+  return Next::Case;
+}
+
+Next playCase(const AppArgs& args, AppWindow& w, AppFlow& flow, int& rc) {
+  AppArgs case_args = args;
+  case_args.record = flow.record;
+  flow.record.clear();  // a second case must not overwrite the first one's recording
+  flow.result = {};
+  flow.message.clear();
+  rc = runCase(case_args, flow.scene_path, flow.choice.hands_on, flow.choice.trainee, w, flow.result);
+  return rc == 0 && flow.result.ended ? Next::Debrief : Next::Quit;
+}
+
+// The debrief, and the replay from it, until the trainee restarts, goes back or quits.
+Next debrief(const AppArgs& args, AppWindow& w, AppFlow& flow) {
+  while (true) {
+    switch (tools::runDebrief(*w.window, *w.layer, flow.result, flow.message, screenExit(args))) {
+      case tools::DebriefAction::Restart: return Next::Case;
+      case tools::DebriefAction::Cases: return Next::Start;
+      case tools::DebriefAction::Quit: return Next::Quit;
+      case tools::DebriefAction::Replay: break;
+    }
+    const tools::ReplayEnd end = tools::runReplay(*w.window, *w.layer, flow.result.recording, screenExit(args));
+    if (end.quit) return Next::Quit;
+    flow.message = end.problem;
+    if (!end.problem.empty()) std::printf("hysim-app: %s\n", end.problem.c_str());
+  }
+}
+
+// The screens in turn: a case given on the command line first, else the start screen; after a
+// case its debrief, and from there the case again or the start screen, until the trainee quits.
 int runApp(const AppArgs& args) {
   auto opened = openWindow(args);
   if (!opened.ok()) return fail(opened.error());
   const char* user = std::getenv("USER");
-  std::string trainee = !args.trainee.empty() ? args.trainee : (user != nullptr ? user : "");
-  bool hands_on = false;
-  const std::string scene_path = chooseScene(args, *opened, hands_on, trainee);
-  if (scene_path.empty()) return 0;
-  return runCase(args, scene_path, hands_on, trainee, *opened);
+  AppFlow flow;
+  flow.choice.trainee = !args.trainee.empty() ? args.trainee : (user != nullptr ? user : "");
+  flow.scene_path = args.scene;
+  flow.record = args.record;
+  Next next = args.scene.empty() ? Next::Start : Next::Case;
+  int rc = 0;
+  while (next != Next::Quit) {
+    switch (next) {
+      case Next::Start: next = startScreen(args, *opened, flow); break;
+      case Next::Case: next = playCase(args, *opened, flow, rc); break;
+      case Next::Debrief: next = debrief(args, *opened, flow); break;
+      case Next::Quit: break;
+    }
+  }
+  return rc;
 }
 
 }  // namespace
