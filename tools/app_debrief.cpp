@@ -3,7 +3,6 @@
 #include <imgui.h>
 
 #include <algorithm>
-#include <cstdio>
 #include <filesystem>
 #include <optional>
 
@@ -55,20 +54,19 @@ double resectionThreshold(const engine::Assessment& a) {
   return 0.0;
 }
 
-// Two bar plots, one bar per committed pass (hover a bar for its value).
+// Two bar plots, one bar per committed pass (hover a bar for its value), each under its caption.
 void drawTimeline(const PassTimeline& t, double threshold_pct, float width) {
-  ImGui::Text("per pass");
   if (t.resected_pct.empty()) {
+    ImGui::Text("per pass");
     ImGui::TextDisabled("no pass was committed (the electrode never cut through tissue)");
     return;
   }
-  char overlay[96];
-  std::snprintf(overlay, sizeof(overlay), "myoma resected so far: %.1f %% after pass %zu (to pass: %.0f %%)",
-                t.resected_pct.back(), t.resected_pct.size(), threshold_pct);
-  ImGui::PlotHistogram("##resected", t.resected_pct.data(), static_cast<int>(t.resected_pct.size()), 0, overlay, 0.0f,
+  ImGui::Text("myoma resected so far, per pass: %.1f %% after pass %zu (to pass: %.0f %%)", t.resected_pct.back(),
+              t.resected_pct.size(), threshold_pct);
+  ImGui::PlotHistogram("##resected", t.resected_pct.data(), static_cast<int>(t.resected_pct.size()), 0, nullptr, 0.0f,
                        resectionPlotTop(t, threshold_pct), ImVec2(width, 110.0f));
-  std::snprintf(overlay, sizeof(overlay), "healthy tissue removed by each pass, mm3 (largest %.1f)", t.max_healthy_mm3);
-  ImGui::PlotHistogram("##healthy", t.healthy_mm3.data(), static_cast<int>(t.healthy_mm3.size()), 0, overlay, 0.0f,
+  ImGui::Text("healthy tissue removed by each pass, mm3 (largest %.1f)", t.max_healthy_mm3);
+  ImGui::PlotHistogram("##healthy", t.healthy_mm3.data(), static_cast<int>(t.healthy_mm3.size()), 0, nullptr, 0.0f,
                        std::max(1.0f, t.max_healthy_mm3 * 1.1f), ImVec2(width, 80.0f));
   ImGui::TextDisabled("passes ended at %.1f s ... %.1f s of simulated time", t.time_s.front(), t.time_s.back());
 }

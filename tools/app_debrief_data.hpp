@@ -36,8 +36,8 @@ struct PassTimeline {
 PassTimeline passTimeline(const std::vector<engine::PassRecord>& passes, double initial_myoma_mm3);
 
 // The top of the resection plot: a tenth above the threshold or the last value, whichever is
-// higher (at most 100 %, at least 1 %), so that a small resection still shows and the target
-// is on the same scale.
+// higher (at most 100 %, at least 1 %), so that the bars read against the target rather than
+// against the whole myoma.
 float resectionPlotTop(const PassTimeline& timeline, double min_resected_pct);
 
 }  // namespace hysim::tools

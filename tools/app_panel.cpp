@@ -94,7 +94,7 @@ void drawPanel(const engine::Scene& scene, const engine::Simulation& sim, Panel&
   const char* path = gamepad.active()              ? "game controller"
                      : panel.manual                ? "keyboard"
                      : sim.state().time < path_end_s ? "scripted demo"
-                                                     : "demo done: Enter for the debrief";
+                                                     : "demo done (Enter: debrief)";
   ImGui::Text("scope        %s", path);
   if (gamepad.active()) gamepad.drawPanel();
   recording.drawPanel();

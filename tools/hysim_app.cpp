@@ -1,6 +1,8 @@
 // hysim-app: the trainee window. Loads a scene, runs the fixed-step simulation paced to
 // real time, shows the hysteroscope view (SDL2 + OpenGL 3.3) and an ImGui panel with the
-// numbers a trainee and an instructor watch.
+// numbers a trainee and an instructor watch. Around the case: the start screen (and the
+// progress screen from it) before, the debrief (and the session's replay) after, in turn
+// until the trainee quits.
 //
 // Pacing is this program's job (the physics never reads the wall clock): wall time is
 // accumulated and the scene's fixed dt is stepped as often as due, with the catch-up
