@@ -96,10 +96,12 @@ struct CaseLoop {
   long frame = 0;
 };
 
-// A key the panel did not take. True: quit.
+// A key the panel did not take. True: the case ends (quit, or Enter: to the debrief).
 bool handleKey(SDL_Keycode key, CaseLoop& c) {
   switch (key) {
     case SDLK_ESCAPE: return true;
+    case SDLK_RETURN:
+    case SDLK_KP_ENTER: c.panel.end_requested = true; return true;
     case SDLK_SPACE: c.panel.paused = !c.panel.paused; break;
     case SDLK_r: c.panel.reset_requested = true; break;
     case SDLK_l: c.panel.lens_index = (c.panel.lens_index + 1) % 3; break;
@@ -308,6 +310,7 @@ void timeFrame(CaseLoop& c, Clock::time_point now) {
   c.frame_ms += a * (1e3 * elapsed - c.frame_ms);
   if (c.options.frames >= 0 && c.frame + 1 >= c.options.frames) c.quit = true;
   if (c.options.quit_after_s >= 0.0 && seconds(now - c.start) >= c.options.quit_after_s) c.quit = true;
+  if (c.panel.end_requested) c.quit = true;  // (the panel's button, last frame)
 }
 
 // One frame: events, the input to the simulation, the scope view, the panel. Every way out
@@ -341,8 +344,9 @@ Status runFrame(CaseLoop& c) {
   return {};
 }
 
-// Ends the session (stored, logged) and prints its last line and the frame-rate figures.
-void endAndPrint(CaseLoop& c) {
+// Ends the session (stored, logged), prints its last line and the frame-rate figures, and
+// returns what the debrief shows.
+CaseResult endAndPrint(CaseLoop& c) {
   const engine::PaceStats pace = c.sim_thread.access([&c] { return c.sim_thread.stats(); });
   c.sim_thread.attach(nullptr);
   const engine::Simulation& sim = *c.session.sim;
@@ -355,6 +359,7 @@ void endAndPrint(CaseLoop& c) {
   int dw = 0, dh = 0;
   c.w.window->drawableSize(dw, dh);
   std::printf("hysim-app: frames %s\n", c.frame_stats.summary(dw, dh, pace.sim_s, pace.wall_s, pace.behind_s).c_str());
+  return caseResult(c.session, c.panel.end_requested);
 }
 
 // Everything before the first frame: the pad, the store, the first session, the panel.
@@ -381,7 +386,7 @@ Status prepareCase(CaseLoop& c, const std::string& scene_path) {
 
 }  // namespace
 
-int runCase(const CaseOptions& options, const std::string& scene_path, AppWindow& w) {
+int runCase(const CaseOptions& options, const std::string& scene_path, AppWindow& w, CaseResult& result) {
   auto scene = engine::loadScene(scene_path);
   if (!scene.ok()) return fail(scene.error());
   CaseLoop c(options, w, std::move(scene.value()));
@@ -392,7 +397,7 @@ int runCase(const CaseOptions& options, const std::string& scene_path, AppWindow
       return fail(s.error());
     }
   }
-  endAndPrint(c);
+  result = endAndPrint(c);
   return c.screenshot_failed ? 1 : 0;
 }
 

@@ -5,6 +5,7 @@
 #include <memory>
 #include <string>
 
+#include "app_case_result.hpp"
 #include "app_gamepad.hpp"
 #include "app_input_player.hpp"
 #include "hysim/render/imgui_layer.hpp"
@@ -35,7 +36,8 @@ struct CaseOptions {
   InputPlayer* input = nullptr;  // scripted input, whose sim events the frame loop plays; null: none
 };
 
-// Runs the case until the trainee quits; returns the process's exit status.
-int runCase(const CaseOptions& options, const std::string& scene_path, AppWindow& w);
+// Runs the case until the trainee quits or ends it (Enter, or the panel's button: the debrief
+// follows); `result` is what the debrief shows. Returns the process's exit status.
+int runCase(const CaseOptions& options, const std::string& scene_path, AppWindow& w, CaseResult& result);
 
 }  // namespace hysim::tools

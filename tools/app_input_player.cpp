@@ -2,44 +2,62 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 
 namespace hysim::tools {
 
 InputPlayer::~InputPlayer() {
-  if (timer_ != 0) SDL_RemoveTimer(timer_);
+  for (Clock& clock : clocks_) {
+    if (clock.timer != 0) SDL_RemoveTimer(clock.timer);
+  }
 }
 
 Status InputPlayer::start(InputScript script, render::SdlWindow& window) {
-  for (const auto* events : {&script.wall, &script.sim}) {
-    for (const ScriptEvent& e : *events) {
-      const bool keyed = e.action == ScriptEvent::Action::Down || e.action == ScriptEvent::Action::Up ||
-                         e.action == ScriptEvent::Action::Tap;
-      if (keyed && SDL_GetScancodeFromName(e.argument.c_str()) == SDL_SCANCODE_UNKNOWN) {
-        return Error{script.path + ":" + std::to_string(e.line) + ": unknown key '" + e.argument +
-                     "' (SDL key names: W, Left Shift, Return, Escape, Up, ...)"};
-      }
+  std::vector<const ScriptEvent*> all;
+  for (const ScriptEvent& e : script.sim) all.push_back(&e);
+  for (const auto& [clock, events] : script.timed) {
+    for (const ScriptEvent& e : events) all.push_back(&e);
+  }
+  for (const ScriptEvent* e : all) {
+    const bool keyed = e->action == ScriptEvent::Action::Down || e->action == ScriptEvent::Action::Up ||
+                       e->action == ScriptEvent::Action::Tap;
+    if (keyed && SDL_GetScancodeFromName(e->argument.c_str()) == SDL_SCANCODE_UNKNOWN) {
+      return Error{script.path + ":" + std::to_string(e->line) + ": unknown key '" + e->argument +
+                   "' (SDL key names: W, Left Shift, Return, Escape, Up, ...)"};
     }
   }
   if (SDL_InitSubSystem(SDL_INIT_TIMER) != 0) return Error{std::string("SDL timer: ") + SDL_GetError()};
   script_ = std::move(script);
   window_ = &window;
-  start_ = std::chrono::steady_clock::now();
-  if (!script_.wall.empty()) {
-    timer_ = SDL_AddTimer(1, &InputPlayer::onTimer, this);
-    if (timer_ == 0) return Error{std::string("SDL timer: ") + SDL_GetError()};
-  }
+  startClock("wall");
   return {};
 }
 
-Uint32 InputPlayer::onTimer(Uint32 /*interval_ms*/, void* self) { return static_cast<InputPlayer*>(self)->pushWallDue(); }
+void InputPlayer::enterScreen(const std::string& screen) {
+  if (window_ != nullptr) startClock(screen);
+}
 
-// On SDL's timer thread: the wall events due now; the time to the next one (0: the last is done).
-Uint32 InputPlayer::pushWallDue() {
-  const double now_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
-  while (next_wall_ < script_.wall.size() && script_.wall[next_wall_].time_s <= now_s) push(script_.wall[next_wall_++]);
-  if (next_wall_ >= script_.wall.size()) return 0;
-  const double wait_ms = 1e3 * (script_.wall[next_wall_].time_s - now_s);
+void InputPlayer::startClock(const std::string& name) {
+  const auto events = script_.timed.find(name);
+  if (events == script_.timed.end() || !started_.insert(name).second) return;
+  Clock& clock = clocks_.emplace_back();
+  clock.player = this;
+  clock.events = &events->second;
+  clock.start = std::chrono::steady_clock::now();
+  clock.timer = SDL_AddTimer(1, &InputPlayer::onTimer, &clock);
+  if (clock.timer == 0) std::fprintf(stderr, "hysim-app: SDL timer: %s\n", SDL_GetError());
+}
+
+Uint32 InputPlayer::onTimer(Uint32 /*interval_ms*/, void* clock) { return pushDue(*static_cast<Clock*>(clock)); }
+
+// On SDL's timer thread: the clock's events due now; the time to its next one (0: done).
+Uint32 InputPlayer::pushDue(Clock& clock) {
+  const std::vector<ScriptEvent>& events = *clock.events;
+  const double now_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - clock.start).count();
+  while (clock.next < events.size() && events[clock.next].time_s <= now_s) clock.player->push(events[clock.next++]);
+  if (clock.next >= events.size()) return 0;
+  const double wait_ms = 1e3 * (events[clock.next].time_s - now_s);
   return static_cast<Uint32>(std::clamp(std::ceil(wait_ms), 1.0, 1e6));
 }
 

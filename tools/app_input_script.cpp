@@ -31,6 +31,14 @@ bool parseAction(const std::string& word, ScriptEvent::Action& action) {
   return false;
 }
 
+bool knownClock(const std::string& clock) {
+  if (clock == "wall" || clock == "sim") return true;
+  for (const char* screen : kScriptScreens) {
+    if (clock == screen) return true;
+  }
+  return false;
+}
+
 // One non-empty line without its comment. The error says what is wrong with it.
 Result<ScriptEvent> parseLine(const std::string& line, int number) {
   std::istringstream in(line);
@@ -38,13 +46,10 @@ Result<ScriptEvent> parseLine(const std::string& line, int number) {
   in >> clock >> time >> action;
   ScriptEvent e;
   e.line = number;
-  if (clock == "wall") {
-    e.clock = ScriptEvent::Clock::Wall;
-  } else if (clock == "sim") {
-    e.clock = ScriptEvent::Clock::Sim;
-  } else {
-    return Error{"the clock must be wall or sim, not '" + clock + "'"};
+  if (!knownClock(clock)) {
+    return Error{"the clock must be wall, sim, start, progress, debrief or replay, not '" + clock + "'"};
   }
+  e.clock = clock;
   char* end = nullptr;
   e.time_s = std::strtod(time.c_str(), &end);
   if (time.empty() || *end != '\0' || !std::isfinite(e.time_s) || e.time_s < 0.0 || e.time_s > 1e6) {
@@ -77,11 +82,11 @@ Result<InputScript> parseInputScript(const std::string& text, const std::string&
     if (line.empty()) continue;
     auto event = parseLine(line, number);
     if (!event.ok()) return Error{path + ":" + std::to_string(number) + ": " + event.error()};
-    (event->clock == ScriptEvent::Clock::Wall ? script.wall : script.sim).push_back(*event);
+    (event->clock == "sim" ? script.sim : script.timed[event->clock]).push_back(*event);
   }
   const auto by_time = [](const ScriptEvent& a, const ScriptEvent& b) { return a.time_s < b.time_s; };
-  std::stable_sort(script.wall.begin(), script.wall.end(), by_time);
   std::stable_sort(script.sim.begin(), script.sim.end(), by_time);
+  for (auto& [clock, events] : script.timed) std::stable_sort(events.begin(), events.end(), by_time);
   return script;
 }
 

@@ -23,6 +23,7 @@ void drawControls(Panel& panel) {
     panel.paused = !panel.paused;
   }
   if (ImGui::Button("Reset (R)", ImVec2(-1, 0))) panel.reset_requested = true;
+  if (ImGui::Button("End the case: debrief (Enter)", ImVec2(-1, 0))) panel.end_requested = true;
   ImGui::SliderFloat("speed", &panel.speed, 0.05f, 1.0f, "%.2fx");
   ImGui::Text("lens (L)");
   for (int i = 0; i < 3; ++i) {
@@ -46,7 +47,7 @@ void drawControls(Panel& panel) {
   }
   ImGui::Checkbox("details (I)", &panel.details);
   ImGui::TextDisabled("X: force e-stop, F: reset force");
-  ImGui::TextDisabled("Esc: quit");
+  ImGui::TextDisabled("Enter: end the case (debrief), Esc: quit");
 }
 
 // The developer's numbers, shown with "details": step time, substeps, pacing, forces,
@@ -93,7 +94,7 @@ void drawPanel(const engine::Scene& scene, const engine::Simulation& sim, Panel&
   const char* path = gamepad.active()              ? "game controller"
                      : panel.manual                ? "keyboard"
                      : sim.state().time < path_end_s ? "scripted demo"
-                                                     : "demo done (holding last pose)";
+                                                     : "demo done (Enter: debrief)";
   ImGui::Text("scope        %s", path);
   if (gamepad.active()) gamepad.drawPanel();
   recording.drawPanel();

@@ -17,6 +17,7 @@ namespace hysim::tools {
 struct Panel {
   bool paused = false;
   bool reset_requested = false;
+  bool end_requested = false;  // the trainee ended the case: the debrief comes next
   int lens_index = 2;  // 0, 12, 30 degrees
   float speed = 1.0f;
   bool manual = false;  // keyboard drives the scope instead of the scripted path

@@ -4,6 +4,7 @@
 
 #include <cstdio>
 
+#include "app_debrief_data.hpp"
 #include "hysim/engine/assessment.hpp"
 
 namespace hysim::tools {
@@ -42,8 +43,7 @@ void AppSessionStore::finish(const engine::Scene& scene, const GuidanceNumbers& 
   record_.perforations = n.perforations;
   record_.electrode_active_s = n.electrode_active_s;
   record_.passes = n.passes;
-  const engine::Assessment a =
-      engine::assess(scene.assessment, {n.myoma_resected_pct, n.healthy_removed_mm3, n.perforations, n.elapsed_s});
+  const engine::Assessment a = engine::assess(scene.assessment, assessedOutcome(n));
   record_.score = a.score;
   record_.passed = a.passed;
   note(store_->finish(record_));

@@ -16,7 +16,7 @@ struct StartState {
   int selected = -1;
   bool hands_on = false;
   char trainee[64] = {};
-  bool start = false, quit = false;
+  bool start = false, quit = false, progress = false;
 };
 
 bool startable(const std::vector<CaseInfo>& cases, int i) {
@@ -36,6 +36,7 @@ void handleKey(SDL_Keycode key, const std::vector<CaseInfo>& cases, StartState& 
     case SDLK_UP: s.selected = nextStartable(cases, s.selected, -1); break;
     case SDLK_DOWN: s.selected = nextStartable(cases, s.selected, 1); break;
     case SDLK_h: s.hands_on = !s.hands_on; break;
+    case SDLK_p: s.progress = true; break;
     case SDLK_RETURN:
     case SDLK_KP_ENTER: s.start = startable(cases, s.selected); break;
     default: break;
@@ -91,20 +92,25 @@ void drawStartScreen(const std::vector<CaseInfo>& cases, StartState& s, float w,
   ImGui::Spacing();
   if (ImGui::Button("Start (Enter)") && startable(cases, s.selected)) s.start = true;
   ImGui::SameLine();
+  if (ImGui::Button("My progress (P)")) s.progress = true;
+  ImGui::SameLine();
   if (ImGui::Button("Quit (Esc)")) s.quit = true;
   ImGui::TextDisabled("Up/Down: choose a case, H: demo or hands-on. Your sessions are stored under your name.");
+  ImGui::TextDisabled("In a case, Enter ends it and shows the debrief.");
   ImGui::End();
 }
 
 }  // namespace
 
 StartChoice runStartScreen(render::SdlWindow& window, render::ImGuiLayer& layer, const std::vector<CaseInfo>& cases,
-                           const std::string& trainee, const StartScreenExit& exit) {
+                           const StartChoice& last, const StartScreenExit& exit) {
+  SDL_SetWindowTitle(window.nativeWindow(), "hysim");
   StartState s;
-  std::strncpy(s.trainee, trainee.c_str(), sizeof(s.trainee) - 1);
-  s.selected = nextStartable(cases, -1, 1);
+  std::strncpy(s.trainee, last.trainee.c_str(), sizeof(s.trainee) - 1);
+  s.selected = startable(cases, last.index) ? last.index : nextStartable(cases, -1, 1);
+  s.hands_on = last.hands_on;
   const auto start = std::chrono::steady_clock::now();
-  for (long frame = 1; !s.start && !s.quit; ++frame) {
+  for (long frame = 1; !s.start && !s.quit && !s.progress; ++frame) {
     SDL_Event event;
     while (SDL_PollEvent(&event)) {
       const bool taken = layer.processEvent(event);
@@ -129,7 +135,8 @@ StartChoice runStartScreen(render::SdlWindow& window, render::ImGuiLayer& layer,
     s.quit = s.quit || timed_out;
   }
   StartChoice c;
-  c.quit = !s.start;
+  c.quit = !s.start && (s.quit || !s.progress);
+  c.progress = !s.start && !c.quit;
   c.index = s.selected;
   c.hands_on = s.hands_on;
   c.trainee = s.trainee;

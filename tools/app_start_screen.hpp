@@ -11,8 +11,9 @@
 namespace hysim::tools {
 
 struct StartChoice {
-  bool quit = false;  // the trainee left (Esc, Quit, the window closed, or quit_after_s)
-  int index = -1;     // the case started
+  bool quit = false;      // the trainee left (Esc, Quit, the window closed, or quit_after_s)
+  bool progress = false;  // the trainee asked for the progress screen (P)
+  int index = -1;         // the case started (or selected, with progress)
   bool hands_on = false;
   std::string trainee;
 };
@@ -23,9 +24,10 @@ struct StartScreenExit {
   std::string screenshot;      // PNG of the last frame when leaving that way
 };
 
-// Runs until a case is started or the trainee quits. Keys: Up/Down choose, Enter starts,
-// H toggles hands-on, Esc quits.
+// Runs until a case is started, the progress screen is asked for or the trainee quits. Keys:
+// Up/Down choose, Enter starts, H toggles hands-on, P progress, Esc quits. `last` is what the
+// screen opens with: the trainee's name, and the case and mode chosen before (index -1: the first).
 StartChoice runStartScreen(render::SdlWindow& window, render::ImGuiLayer& layer, const std::vector<CaseInfo>& cases,
-                           const std::string& trainee, const StartScreenExit& exit);
+                           const StartChoice& last, const StartScreenExit& exit);
 
 }  // namespace hysim::tools

@@ -1,6 +1,8 @@
 // hysim-app: the trainee window. The start screen (or the command line) picks a case; the case
 // runs with its simulation on its own thread, paced to real time (app_case_loop.cpp), the
-// hysteroscope view (SDL2 + OpenGL 3.3) and an ImGui panel with the trainee's guidance.
+// hysteroscope view (SDL2 + OpenGL 3.3) and an ImGui panel with the trainee's guidance. Around
+// the case: the start screen (and the progress screen from it) before, the debrief (and the
+// session's replay) after, in turn until the trainee quits.
 #include <CLI/CLI.hpp>
 #include <cstdlib>
 #include <filesystem>
@@ -9,6 +11,10 @@
 #include <vector>
 
 #include "app_case_loop.hpp"
+#include "app_case_result.hpp"
+#include "app_debrief.hpp"
+#include "app_progress.hpp"
+#include "app_replay.hpp"
 #include "app_input_player.hpp"
 #include "app_input_script.hpp"
 #include "app_cases.hpp"
@@ -58,19 +64,95 @@ Result<tools::AppWindow> openWindow(const AppArgs& args) {
   return tools::AppWindow{std::move(window.value()), std::move(layer.value())};
 }
 
-// The scene to run: the command line's, else the case the trainee starts on the start screen
-// (empty: the trainee quit there). The start screen also sets the mode and the trainee's name.
-std::string chooseScene(const AppArgs& args, tools::AppWindow& w, bool& hands_on, std::string& trainee) {
-  if (!args.scene.empty()) return args.scene;
-  const std::vector<tools::CaseInfo> cases = tools::listCases(fs::path(tools::defaultScenePath()).parent_path().string());
-  const tools::StartChoice choice =
-      tools::runStartScreen(*w.window, *w.layer, cases, trainee, {args.quit_after_s, args.frames, args.screenshot});
-  if (choice.quit) return {};
-  hands_on = choice.hands_on;
-  if (!choice.trainee.empty()) trainee = choice.trainee;
-  return cases[choice.index].path;
+// Where the trainee is between screens: the start screen's choices, the case, its result.
+struct AppFlow {
+  std::vector<tools::CaseInfo> cases;
+  tools::StartChoice choice;  // the trainee, the case and the mode
+  std::string scene_path;
+  std::string record;         // --record, for the first case only (later ones get new files)
+  tools::CaseResult result;
+  std::string message;        // for the debrief: why the replay could not play
+  tools::InputPlayer* input = nullptr;  // scripted input (--input); null: none
+};
+
+// Scripted input's clocks for the screens start when they first open.
+void entering(const AppFlow& flow, const char* screen) {
+  if (flow.input != nullptr) flow.input->enterScreen(screen);
 }
 
+enum class Next { Start, Case, Debrief, Quit };
+
+tools::StartScreenExit screenExit(const AppArgs& args) { return {args.quit_after_s, args.frames, args.screenshot}; }
+
+// The start screen, and the progress screen from it, until a case is chosen or the trainee quits.
+Next startScreen(const AppArgs& args, tools::AppWindow& w, AppFlow& flow) {
+  if (flow.cases.empty()) {
+    flow.cases = tools::listCases(fs::path(tools::defaultScenePath()).parent_path().string());
+  }
+  while (true) {
+    entering(flow, "start");
+    const tools::StartChoice c = tools::runStartScreen(*w.window, *w.layer, flow.cases, flow.choice, screenExit(args));
+    if (!c.trainee.empty()) flow.choice.trainee = c.trainee;
+    flow.choice.index = c.index;
+    flow.choice.hands_on = c.hands_on;
+    if (c.quit) return Next::Quit;
+    if (!c.progress) break;
+    entering(flow, "progress");
+    if (!tools::runProgress(*w.window, *w.layer, args.data_dir, flow.choice.trainee, screenExit(args))) {
+      return Next::Quit;
+    }
+  }
+  flow.scene_path = flow.cases[flow.choice.index].path;
+  return Next::Case;
+}
+
+// The case's options from the command line and the start screen's choices.
+tools::CaseOptions caseOptions(const AppArgs& args, const AppFlow& flow) {
+  tools::CaseOptions options;
+  options.frames = args.frames;
+  options.quit_after_s = args.quit_after_s;
+  options.screenshot = args.screenshot;
+  options.alarm_screenshot = args.alarm_screenshot;
+  options.paused = args.paused;
+  options.gamepad = args.gamepad;
+  options.record = flow.record;
+  options.trainee = flow.choice.trainee;
+  options.data_dir = args.data_dir;
+  options.hands_on = flow.choice.hands_on;
+  options.max_fps = args.max_fps;
+  options.input = flow.input;
+  return options;
+}
+
+Next playCase(const AppArgs& args, tools::AppWindow& w, AppFlow& flow, int& rc) {
+  const tools::CaseOptions options = caseOptions(args, flow);
+  flow.record.clear();  // a second case must not overwrite the first one's recording
+  flow.result = {};
+  flow.message.clear();
+  rc = tools::runCase(options, flow.scene_path, w, flow.result);
+  return rc == 0 && flow.result.ended ? Next::Debrief : Next::Quit;
+}
+
+// The debrief, and the replay from it, until the trainee restarts, goes back or quits.
+Next debrief(const AppArgs& args, tools::AppWindow& w, AppFlow& flow) {
+  while (true) {
+    entering(flow, "debrief");
+    switch (tools::runDebrief(*w.window, *w.layer, flow.result, flow.message, screenExit(args))) {
+      case tools::DebriefAction::Restart: return Next::Case;
+      case tools::DebriefAction::Cases: return Next::Start;
+      case tools::DebriefAction::Quit: return Next::Quit;
+      case tools::DebriefAction::Replay: break;
+    }
+    entering(flow, "replay");
+    const tools::ReplayEnd end = tools::runReplay(*w.window, *w.layer, flow.result.recording, screenExit(args));
+    if (end.quit) return Next::Quit;
+    flow.message = end.problem;
+    if (!end.problem.empty()) std::printf("hysim-app: %s\n", end.problem.c_str());
+  }
+}
+
+// The screens in turn: a case given on the command line first, else the start screen; after a
+// case its debrief, and from there the case again or the start screen, until the trainee quits.
 int runApp(const AppArgs& args) {
   auto opened = openWindow(args);
   if (!opened.ok()) return fail(opened.error());
@@ -81,24 +163,22 @@ int runApp(const AppArgs& args) {
     if (Status s = input.start(std::move(script.value()), *opened->window); !s.ok()) return fail(s.error());
   }
   const char* user = std::getenv("USER");
-  std::string trainee = !args.trainee.empty() ? args.trainee : (user != nullptr ? user : "");
-  bool hands_on = false;
-  const std::string scene_path = chooseScene(args, *opened, hands_on, trainee);
-  if (scene_path.empty()) return 0;
-  tools::CaseOptions options;
-  options.frames = args.frames;
-  options.quit_after_s = args.quit_after_s;
-  options.screenshot = args.screenshot;
-  options.alarm_screenshot = args.alarm_screenshot;
-  options.paused = args.paused;
-  options.gamepad = args.gamepad;
-  options.record = args.record;
-  options.trainee = trainee;
-  options.data_dir = args.data_dir;
-  options.hands_on = hands_on;
-  options.max_fps = args.max_fps;
-  options.input = args.input.empty() ? nullptr : &input;
-  return tools::runCase(options, scene_path, *opened);
+  AppFlow flow;
+  flow.input = args.input.empty() ? nullptr : &input;
+  flow.choice.trainee = !args.trainee.empty() ? args.trainee : (user != nullptr ? user : "");
+  flow.scene_path = args.scene;
+  flow.record = args.record;
+  Next next = args.scene.empty() ? Next::Start : Next::Case;
+  int rc = 0;
+  while (next != Next::Quit) {
+    switch (next) {
+      case Next::Start: next = startScreen(args, *opened, flow); break;
+      case Next::Case: next = playCase(args, *opened, flow, rc); break;
+      case Next::Debrief: next = debrief(args, *opened, flow); break;
+      case Next::Quit: break;
+    }
+  }
+  return rc;
 }
 
 }  // namespace

@@ -9,7 +9,7 @@
 namespace hysim::tools {
 namespace {
 
-TEST(InputScript, ParsesBothClocksInTimeOrder) {
+TEST(InputScript, ParsesEachClockInTimeOrder) {
   const auto script = parseInputScript(
       "# pick the case\n"
       "wall 2.0 tap Return\n"
@@ -17,13 +17,17 @@ TEST(InputScript, ParsesBothClocksInTimeOrder) {
       "sim 0.5 down Left Shift\n"
       "\n"
       "sim 0.25 text Ann\n"
-      "sim 3 capture out/case.png\n",
+      "sim 3 capture out/case.png\n"
+      "debrief 1.5 tap C\n",
       "s.txt");
   ASSERT_TRUE(script.ok()) << script.error();
-  ASSERT_EQ(script->wall.size(), 2u);
-  EXPECT_EQ(script->wall[0].argument, "Down");
-  EXPECT_EQ(script->wall[0].line, 3);
-  EXPECT_EQ(script->wall[1].action, ScriptEvent::Action::Tap);
+  const std::vector<ScriptEvent>& wall = script->timed.at("wall");
+  ASSERT_EQ(wall.size(), 2u);
+  EXPECT_EQ(wall[0].argument, "Down");
+  EXPECT_EQ(wall[0].line, 3);
+  EXPECT_EQ(wall[1].action, ScriptEvent::Action::Tap);
+  ASSERT_EQ(script->timed.at("debrief").size(), 1u);
+  EXPECT_EQ(script->timed.at("debrief")[0].argument, "C");
   ASSERT_EQ(script->sim.size(), 3u);
   EXPECT_EQ(script->sim[0].action, ScriptEvent::Action::Text);
   EXPECT_EQ(script->sim[1].argument, "Left Shift");  // a key name with a space
@@ -34,7 +38,7 @@ TEST(InputScript, ParsesBothClocksInTimeOrder) {
 
 TEST(InputScript, BadLinesNameTheFileAndLine) {
   const std::pair<const char*, const char*> cases[] = {
-      {"wall 1 tap W\nclock 1 tap W\n", "s.txt:2: the clock must be wall or sim"},
+      {"wall 1 tap W\nclock 1 tap W\n", "s.txt:2: the clock must be wall, sim, start"},
       {"sim nan tap W\n", "s.txt:1: the time must be seconds"},
       {"sim -1 tap W\n", "s.txt:1: the time must be seconds"},
       {"sim 1e400 tap W\n", "s.txt:1: the time must be seconds"},

@@ -1,6 +1,7 @@
 // The trainee window as a trainee meets it, under a private X server (Xvfb) with scripted
-// keys (tests/data/app/*.txt): pick a case on the start screen, cut two passes by keys, have
-// the session stored; and the perforating scene's alarm on screen. Pictures are compared with
+// keys (tests/data/app/*.txt): pick a case on the start screen, cut two passes by keys, end
+// the case into the debrief, go back and open the progress screen, the session stored; and the
+// perforating scene's alarm on screen. Pictures are compared with
 // golden images within a tolerance (the view's details depend on frame timing).
 #include <gtest/gtest.h>
 
@@ -92,9 +93,15 @@ TEST_F(AppWindow, StartScreenThenTwoPassesByKeysAreStored) {
   ASSERT_EQ(out.exit_code, 0) << out.text;
   EXPECT_NE(out.text.find("frame captured in start.png"), std::string::npos) << out.text;
   EXPECT_NE(out.text.find("frame captured in case.png"), std::string::npos) << out.text;
+  EXPECT_NE(out.text.find("frame captured in debrief.png"), std::string::npos) << out.text;
+  EXPECT_NE(out.text.find("frame captured in progress.png"), std::string::npos) << out.text;
   EXPECT_NE(out.text.find("warnings 0, perforations 0"), std::string::npos) << out.text;
+  // The start screen is the same every time; the others show the session's own numbers,
+  // times and dates, and the view and plots depend on the frames the keys landed in.
   expectLikeGolden(dir + "/start.png", "app_start.png", 32, 0.002);
   expectLikeGolden(dir + "/case.png", "app_two_passes.png", 64, 0.05);
+  expectLikeGolden(dir + "/debrief.png", "app_debrief.png", 64, 0.03);
+  expectLikeGolden(dir + "/progress.png", "app_progress.png", 64, 0.01);
 
   tools::SessionStore store(dir + "/data");
   ASSERT_TRUE(store.open().ok());
