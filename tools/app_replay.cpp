@@ -3,7 +3,6 @@
 #include <imgui.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -11,14 +10,13 @@
 #include "app_guidance.hpp"
 #include "app_screen.hpp"
 #include "hysim/engine/replay.hpp"
+#include "hysim/engine/sim_thread.hpp"
 #include "hysim/engine/simulation.hpp"
 #include "hysim/haptics/replay_device.hpp"
 #include "hysim/render/renderer.hpp"
 
 namespace hysim::tools {
 namespace {
-
-using Clock = std::chrono::steady_clock;
 
 // A recording ready to step: its simulation, the source its devices read, and a renderer.
 struct ReplayRun {
@@ -59,7 +57,11 @@ Result<ReplayRun> loadReplay(const std::string& path) {
 
 class ReplayScreen final : public Screen {
  public:
-  explicit ReplayScreen(ReplayRun run) : run_(std::move(run)), last_(Clock::now()) {}
+  // The recording plays on the simulation thread, paced to real time, and pauses at its end.
+  explicit ReplayScreen(ReplayRun run) : run_(std::move(run)) {
+    sim_thread_.attach(run_.sim.get(), [this](engine::Simulation& sim) { afterStep(sim); });
+  }
+  ~ReplayScreen() override { sim_thread_.attach(nullptr); }
   void onKey(SDL_Keycode key) override {
     if (key == SDLK_SPACE) paused_ = !paused_;
     if (key == SDLK_b || key == SDLK_BACKSPACE) back_ = true;
@@ -71,36 +73,24 @@ class ReplayScreen final : public Screen {
   bool quit() const { return quit_; }
 
  private:
-  void stepDue();
+  void afterStep(engine::Simulation& sim);
+  void drawPanel();
   void reportEnd();
   ReplayRun run_;
   render::RenderSnapshot snapshot_;
-  Clock::time_point last_;
-  double due_s_ = 0.0;  // simulated time due but not yet stepped
   bool paused_ = false, back_ = false, quit_ = false;
   bool reported_ = false;
+  engine::SimThread sim_thread_;  // last: stops stepping before the run goes
 };
 
-// Real-time pacing within a frame's budget: a machine too slow for the recording plays it in
-// slow motion rather than freezing the window.
-void ReplayScreen::stepDue() {
-  const Clock::time_point now = Clock::now();
-  const double elapsed = std::min(0.1, std::chrono::duration<double>(now - last_).count());
-  last_ = now;
-  if (paused_) return;
-  const double dt = run_.sim->scene().sim.dt;
-  due_s_ += elapsed;
-  const Clock::time_point budget_end = now + std::chrono::milliseconds(66);
-  while (due_s_ >= dt && static_cast<long>(run_.sim->state().steps) < run_.steps_total) {
-    if (Clock::now() >= budget_end) {
-      due_s_ = 0.0;
-      break;
-    }
-    attachRecordedDevices(*run_.sim, run_.source);
-    run_.sim->step();
-    due_s_ -= dt;
+// On the simulation thread: the next step's recorded devices attach; at the recording's end
+// the thread pauses.
+void ReplayScreen::afterStep(engine::Simulation& sim) {
+  attachRecordedDevices(sim, run_.source);
+  if (static_cast<long>(sim.state().steps) >= run_.steps_total) {
+    sim_thread_.setPaused(true);
+    reportEnd();
   }
-  if (static_cast<long>(run_.sim->state().steps) >= run_.steps_total) reportEnd();
 }
 
 // Once, at the recording's end: the state hash, to compare with the session's last line (a
@@ -115,8 +105,11 @@ void ReplayScreen::reportEnd() {
 }
 
 void ReplayScreen::drawScene(render::SdlWindow& window) {
-  stepDue();
-  run_.sim->fillSnapshot(snapshot_);
+  sim_thread_.access([this] {
+    const bool finished = static_cast<long>(run_.sim->state().steps) >= run_.steps_total;
+    sim_thread_.setPaused(paused_ || finished);
+    run_.sim->fillSnapshot(snapshot_);
+  });
   run_.renderer->draw(snapshot_);
   int dw = 0, dh = 0;
   window.drawableSize(dw, dh);
@@ -128,6 +121,11 @@ void ReplayScreen::drawScene(render::SdlWindow& window) {
 }
 
 void ReplayScreen::draw(float, float) {
+  sim_thread_.access([this] { drawPanel(); });
+}
+
+// The replay's numbers and controls, between two steps.
+void ReplayScreen::drawPanel() {
   const engine::Simulation& sim = *run_.sim;
   const GuidanceNumbers n = guidanceNumbers(sim);
   const double end_s = static_cast<double>(run_.steps_total) * sim.scene().sim.dt;

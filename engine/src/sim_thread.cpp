@@ -78,6 +78,7 @@ void SimThread::stepDue(std::unique_lock<std::mutex>& lock, int due) {
     ++stats_.steps;
     stats_.sim_s += pacer_.dt();
     if (after_step_) after_step_(*sim);
+    if (paused_) break;  // the after-step call paused it (e.g. a replay at its end)
   }
   stats_.step_median_us = step_times_.median();
 }

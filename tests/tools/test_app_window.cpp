@@ -137,6 +137,20 @@ TEST_F(AppWindow, PerforatingSceneShowsTheAlarm) {
   EXPECT_NE(out.text.find("perforations 1, alarms 1"), std::string::npos) << out.text;
 }
 
+// The debrief's replay plays the session's recording to the very state the session ended in.
+TEST_F(AppWindow, ReplayFromTheDebriefEndsOnTheSessionsState) {
+  const std::string dir = freshOutputDir("AppWindow", "replay");
+  const Output out = runApp(xvfb_.display(), dir,
+                            std::string(HYSIM_SOURCE_DIR) + "/scenes/default.yaml --input " + dataFile("app/replay.txt"));
+  ASSERT_EQ(out.exit_code, 0) << out.text;
+  std::smatch session, replay;
+  ASSERT_TRUE(std::regex_search(out.text, session, std::regex("perforations 0, alarms 0, state_hash ([0-9a-f]+)")))
+      << out.text;
+  ASSERT_TRUE(std::regex_search(out.text, replay, std::regex("replay of .* finished: .* state_hash ([0-9a-f]+)")))
+      << out.text;
+  EXPECT_EQ(replay[1], session[1]);
+}
+
 // A trainee session killed midway keeps its file and row, marked incomplete.
 TEST_F(AppWindow, KilledMidSessionLeavesAnIncompleteSession) {
   const std::string dir = freshOutputDir("AppWindow", "killed");

@@ -49,7 +49,8 @@ class SimThread {
     waiting_.store(false, std::memory_order_release);
     return std::forward<F>(f)();
   }
-  // Inside access(): pause (time does not run) and speed (simulated seconds per wall second).
+  // Inside access() or the after-step call: pause (time does not run; from the after-step call
+  // no further step is taken) and speed (simulated seconds per wall second).
   void setPaused(bool paused) { paused_ = paused; }
   void setSpeed(double speed) { speed_ = speed; }
   const PaceStats& stats() const { return stats_; }  // inside access()
