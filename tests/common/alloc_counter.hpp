@@ -15,7 +15,10 @@
 #endif
 
 #ifdef HYSIM_ALLOC_COUNT_BY_SANITIZER
-#include <sanitizer/allocator_interface.h>
+// The sanitizers' public allocator interface (sanitizer/allocator_interface.h, which GCC's
+// packages do not ship): hooks called on every allocation and free.
+extern "C" int __sanitizer_install_malloc_and_free_hooks(void (*malloc_hook)(const volatile void*, std::size_t),
+                                                         void (*free_hook)(const volatile void*));
 #else
 extern "C" void* __libc_malloc(std::size_t);
 extern "C" void* __libc_calloc(std::size_t, std::size_t);
