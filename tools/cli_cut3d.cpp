@@ -14,7 +14,7 @@
 #include "hysim/cutting/cut3d.hpp"
 #include "hysim/cutting/mesh_io.hpp"
 #include "hysim/cutting/mesh_stats.hpp"
-#include "hysim/engine/simulation.hpp"
+#include "hysim/engine/cut_surface_file.hpp"
 #include "hysim/render/image.hpp"
 #include "tet_picture.hpp"
 #include "tool_common.hpp"
@@ -25,28 +25,6 @@ namespace {
 int fail(const std::string& m) {
   std::cerr << "hysim: " << m << "\n";
   return 1;
-}
-
-Result<cutting::CutSurface> loadCutSurface(const std::string& path) {
-  const bool msh = path.size() > 4 && (path.substr(path.size() - 4) == ".msh" || path.substr(path.size() - 4) == ".vtk");
-  if (msh) {
-    auto tri = cutting::readTriMesh(path);
-    if (!tri.ok()) return Error{tri.error()};
-    auto s = cutting::CutSurface::triangles(tri->X, tri->F);
-    if (!s.ok()) return Error{path + ": " + s.error()};
-    return s;
-  }
-  auto mesh = engine::loadSurface(path, render::SurfaceMaterial{});
-  if (!mesh.ok()) return Error{mesh.error()};
-  cutting::Positions X(static_cast<Eigen::Index>(mesh->positions.size() / 3), 3);
-  for (Eigen::Index i = 0; i < X.rows(); ++i)
-    for (int k = 0; k < 3; ++k) X(i, k) = mesh->positions[3 * i + k];
-  cutting::Tris F(static_cast<Eigen::Index>(mesh->triangles.size() / 3), 3);
-  for (Eigen::Index f = 0; f < F.rows(); ++f)
-    for (int k = 0; k < 3; ++k) F(f, k) = static_cast<std::int32_t>(mesh->triangles[3 * f + k]);
-  auto s = cutting::CutSurface::triangles(X, F);
-  if (!s.ok()) return Error{path + ": " + s.error()};
-  return s;
 }
 
 double median(std::vector<double> v) {
@@ -75,7 +53,7 @@ int runCut3d(const Cut3dArgs& a) {
     surface = cutting::CutSurface::plane(Eigen::Vector3d(v[0], v[1], v[2]), Eigen::Vector3d(v[3], v[4], v[5]));
     if (!surface.ok()) return fail("--plane '" + a.plane + "': " + surface.error());
   } else {
-    surface = loadCutSurface(a.surface);
+    surface = engine::loadCutSurface(a.surface);
   }
   if (!surface.ok()) return fail(surface.error());
   const auto t0 = std::chrono::steady_clock::now();

@@ -135,14 +135,12 @@ Result<Format> formatForReading(const std::string& path, const std::string& text
   return errorIn(path, "unknown mesh format (expected a .msh or .vtk file)");
 }
 
-// Reads and parses a file; `format` receives the format it was read as.
-Result<RawMesh> readRaw(const std::string& path, Format& format) {
-  Result<std::string> text = readInputFile(path, kMaxMeshFileBytes, "mesh");
-  if (!text) return Error{text.error()};
-  Result<Format> detected = formatForReading(path, *text);
+// Parses a file's text; `format` receives the format it was read as.
+Result<RawMesh> parseRaw(const std::string& path, const std::string& text, Format& format) {
+  Result<Format> detected = formatForReading(path, text);
   if (!detected) return Error{detected.error()};
   format = *detected;
-  return format == Format::Msh ? parseMsh(path, *text) : parseVtk(path, *text);
+  return format == Format::Msh ? parseMsh(path, text) : parseVtk(path, text);
 }
 
 Positions toPositions(const std::vector<double>& xyz) {
@@ -276,8 +274,20 @@ Status writeAny(const std::string& path, const Positions& X, const Elements& E, 
 }  // namespace
 
 Result<TetMesh> readTetMesh(const std::string& path) {
+  Result<std::string> text = readInputFile(path, kMaxMeshFileBytes, "mesh");
+  if (!text) return Error{text.error()};
+  return parseTetMesh(path, *text);
+}
+
+Result<TriMesh> readTriMesh(const std::string& path) {
+  Result<std::string> text = readInputFile(path, kMaxMeshFileBytes, "mesh");
+  if (!text) return Error{text.error()};
+  return parseTriMesh(path, *text);
+}
+
+Result<TetMesh> parseTetMesh(const std::string& path, const std::string& text) {
   Format format = Format::Msh;
-  Result<RawMesh> raw = readRaw(path, format);
+  Result<RawMesh> raw = parseRaw(path, text, format);
   if (!raw) return Error{raw.error()};
   if (raw->tets.empty()) {
     return errorIn(path, format == Format::Msh ? "no tetrahedra (MSH element type 4) in file"
@@ -290,9 +300,9 @@ Result<TetMesh> readTetMesh(const std::string& path) {
   return mesh;
 }
 
-Result<TriMesh> readTriMesh(const std::string& path) {
+Result<TriMesh> parseTriMesh(const std::string& path, const std::string& text) {
   Format format = Format::Msh;
-  Result<RawMesh> raw = readRaw(path, format);
+  Result<RawMesh> raw = parseRaw(path, text, format);
   if (!raw) return Error{raw.error()};
   if (raw->tris.empty()) {
     return errorIn(path, format == Format::Msh ? "no triangles (MSH element type 2) in file"

@@ -461,9 +461,13 @@ bool AnchorRegion::contains(const Eigen::Vector3d& p) const {
 Result<Scene> loadScene(const std::string& path) {
   Result<std::string> text = readInputFile(path, kMaxYamlFileBytes, "scene");
   if (!text.ok()) return Error{text.error()};
+  return parseScene(*text, path);
+}
+
+Result<Scene> parseScene(const std::string& text, const std::string& path) {
   const Reader reader(path);
   try {
-    const YAML::Node root = YAML::Load(*text);
+    const YAML::Node root = YAML::Load(text);
     long visited = 0;
     reader.checkDocument(root, "scene", 0, visited);
     return parse(reader, root, path);

@@ -319,6 +319,11 @@ void RecordingWriter::discard() {
 bool readRecording(const std::string& path, Recording& out, std::string& error) {
   std::vector<unsigned char> bytes;
   if (!readWholeFile(path, bytes, error)) return false;
+  return parseRecording(bytes, path, out, error);
+}
+
+bool parseRecording(const std::vector<unsigned char>& bytes, const std::string& path, Recording& out,
+                    std::string& error) {
   Reader r{bytes, path, 0, error};
   return readHeader(r, out.header) && readRecords(r, out);
 }

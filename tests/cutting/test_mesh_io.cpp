@@ -198,6 +198,21 @@ TEST(MshIo, ReadsNonContiguousIdsMixedElementsAndExtraSections) {
   EXPECT_EQ(tris->material, (Labels(2) << 11, 0).finished());  // no tags: material 0
 }
 
+TEST(MeshIo, ParsingTextInMemoryMatchesReadingTheFile) {
+  const std::string path = dataPath("mixed_ids.msh");
+  const Result<TetMesh> read = readTetMesh(path);
+  const Result<TetMesh> parsed = parseTetMesh(path, readText(path));
+  ASSERT_TRUE(read.ok() && parsed.ok());
+  EXPECT_EQ(parsed->X, read->X);
+  EXPECT_EQ(parsed->T, read->T);
+  const Result<TriMesh> tris = parseTriMesh("memory.vtk", readText(dataPath("meshio_field.vtk")));
+  ASSERT_TRUE(tris.ok()) << tris.error();
+  EXPECT_EQ(tris->numTris(), 1);
+  const Result<TetMesh> bad = parseTetMesh("memory.msh", "$MeshFormat\n9.9 0 8\n");
+  ASSERT_FALSE(bad.ok());
+  EXPECT_EQ(bad.error().rfind("memory.msh:", 0), 0u) << bad.error();
+}
+
 TEST(VtkIo, ReadsVersion51OffsetsLayoutWithMetadata) {
   const Result<TetMesh> m = readTetMesh(dataPath("vtk51_offsets.vtk"));
   ASSERT_TRUE(m.ok()) << m.error();

@@ -109,6 +109,15 @@ TEST(Scene, AssessmentAndCaseParse) {
   EXPECT_TRUE(plain->figo_type.empty());
 }
 
+TEST(Scene, ParsingTextInMemoryResolvesPathsAgainstTheNamedFolder) {
+  auto scene = parseScene(minimalScene("uterus_myoma.msh"), kAssets + "/memory.yaml");
+  ASSERT_TRUE(scene.ok()) << scene.error();
+  EXPECT_EQ(scene->mesh_path, kAssets + "/uterus_myoma.msh");
+  auto bad = parseScene("name: [", "memory.yaml");
+  ASSERT_FALSE(bad.ok());
+  EXPECT_EQ(bad.error().rfind("memory.yaml:", 0), 0u) << bad.error();
+}
+
 TEST(SceneErrors, BadAssessmentOrCase) {
   const std::string base = minimalScene() + "assessment:\n";  // line 11
   expectError("assess_pct.yaml", base + "  min_resected_pct: 120\n", ":12:", "'min_resected_pct' must be at most 100");

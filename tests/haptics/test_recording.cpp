@@ -117,6 +117,21 @@ TEST(Recording, RoundTripIsBitExact) {
   EXPECT_EQ(fs::file_size(path), recordAt(500) + kRecordingEndBytes);
 }
 
+TEST(Recording, ParsingBytesInMemoryMatchesReadingTheFile) {
+  const std::string path = writeSample(testing::testDir("Recording"), 5);
+  Recording read, parsed;
+  std::string error;
+  ASSERT_TRUE(readRecording(path, read, error)) << error;
+  ASSERT_TRUE(parseRecording(bytesOf(path), "memory.hyrec", parsed, error)) << error;
+  ASSERT_EQ(parsed.states.size(), read.states.size());
+  EXPECT_EQ(parsed.header.scene_path, read.header.scene_path);
+  for (std::size_t i = 0; i < read.states.size(); ++i) {
+    EXPECT_TRUE(sameBits(parsed.states[i].state.pose.tip, read.states[i].state.pose.tip));
+  }
+  EXPECT_FALSE(parseRecording({}, "memory.hyrec", parsed, error));
+  EXPECT_EQ(error.rfind("memory.hyrec: byte 0: ", 0), 0u) << error;
+}
+
 TEST(Recording, AnOlderFileIsReplacedOnlyWhenTheNewOneIsFinished) {
   const fs::path dir = testing::testDir("Recording");
   const std::string path = writeSample(dir, 10);

@@ -16,6 +16,10 @@ namespace hysim::cutting {
 Result<TetMesh> readTetMesh(const std::string& path);
 // Reads a triangle mesh: the file's triangles (MSH type 2 / VTK cell type 5).
 Result<TriMesh> readTriMesh(const std::string& path);
+// The same readers over a file's text already in memory (fuzzing, tests): `path` chooses the
+// format by its extension (or the text's first line) and names the input in messages.
+Result<TetMesh> parseTetMesh(const std::string& path, const std::string& text);
+Result<TriMesh> parseTriMesh(const std::string& path, const std::string& text);
 
 // Format chosen by extension: .msh or .vtk.
 Status writeMesh(const std::string& path, const TetMesh& mesh);

@@ -115,5 +115,8 @@ struct Scene {
 
 // Parses and checks a scene file. Does not load the meshes (see Simulation::create).
 Result<Scene> loadScene(const std::string& path);
+// The same over a scene file's text already in memory (fuzzing, tests): `path` names it in
+// messages, and relative mesh paths are resolved against its folder.
+Result<Scene> parseScene(const std::string& text, const std::string& path);
 
 }  // namespace hysim::engine

@@ -78,6 +78,9 @@ class RecordingWriter {
 // record that fails its check or holds an impossible state, a truncated file (no end marker,
 // or a partial record), trailing bytes, a record count or checksum that disagrees.
 bool readRecording(const std::string& path, Recording& out, std::string& error);
+// The same over a file's bytes already in memory (fuzzing, tests); `path` names them in messages.
+bool parseRecording(const std::vector<unsigned char>& bytes, const std::string& path, Recording& out,
+                    std::string& error);
 
 // The bytes of one record and back (exposed for tests). decodeRecord returns false with a
 // reason when the record's check fails or its state is impossible.
