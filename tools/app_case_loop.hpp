@@ -32,7 +32,7 @@ struct CaseOptions {
   bool hands_on = false;
   // Frames per second at most (0: as many as the machine draws): a software GL would otherwise
   // draw as fast as it can and take the simulation thread's core.
-  double max_fps = 40.0;
+  double max_fps = 32.0;
   InputPlayer* input = nullptr;  // scripted input, whose sim events the frame loop plays; null: none
 };
 

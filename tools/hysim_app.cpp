@@ -48,7 +48,7 @@ struct AppArgs {
   std::string trainee;   // whose sessions are stored; empty: $USER, else "trainee"
   std::string data_dir;  // the sessions' data folder; empty: the default
   std::string input;     // a scripted input file; empty: none
-  double max_fps = 40.0;
+  double max_fps = 32.0;
 };
 
 Result<tools::AppWindow> openWindow(const AppArgs& args) {
