@@ -1,7 +1,7 @@
 // soak: the default organ's shaving course again and again for a set wall time (a fresh
 // simulation per course, as a trainee's reset makes), with a frame rendered every simulated
 // second, to show that nothing grows or slows over a long session: resident memory after each
-// course, the step's median and 99th percentile, warnings. Not a test (docs/soak.md).
+// course, the step's median and 99th percentile, warnings. Not a test (docs/reliability.md).
 #include <CLI/CLI.hpp>
 #include <chrono>
 #include <cmath>
