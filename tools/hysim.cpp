@@ -12,6 +12,7 @@
 #include "tool_common.hpp"
 #include "cli_accuracy.hpp"
 #include "cli_cut2d.hpp"
+#include "cli_mesh.hpp"
 #include "cli_run.hpp"
 #include "cli_sessions.hpp"
 
@@ -66,6 +67,7 @@ int main(int argc, char** argv) {
   auto cut2d_commands = hysim::tools::addCut2dCommands(app);  // hysim cut, hysim tables
   auto accuracy_command = hysim::tools::addAccuracyCommand(app);
   auto sessions_commands = hysim::tools::addSessionsCommands(app);  // hysim sessions list|export
+  auto mesh_command = hysim::tools::addMeshCommand(app);
 
   try {
     app.parse(argc, argv);
@@ -78,6 +80,7 @@ int main(int argc, char** argv) {
   if (auto rc = hysim::tools::runAccuracyCommand(*accuracy_command)) return *rc;
   if (auto rc = hysim::tools::runRunCommands(*run_commands)) return *rc;
   if (auto rc = hysim::tools::runSessionsCommands(*sessions_commands)) return *rc;
+  if (auto rc = hysim::tools::runMeshCommand(*mesh_command)) return *rc;
   if (*stats_cmd) return statsCommand(stats_path, stats_json);
   return 1;
 }

@@ -5,6 +5,9 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "hysim/engine/shaving_path.hpp"
+#include "scene_reader.hpp"
+
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -15,142 +18,8 @@ namespace hysim::engine {
 namespace {
 
 namespace fs = std::filesystem;
-
-// Every number in a scene is a physical quantity in mm, g, s or kPa, or a count; none comes
-// near 1e9 (1000 km as a position), and products of a few values of at most 1e9 stay far
-// from overflow in the model.
-constexpr double kMaxSceneNumber = 1e9;
-// A walk over a document with aliases can revisit shared parts many times (a "billion laughs"
-// file); past this many nodes the scene is refused.
-constexpr long kMaxSceneNodes = 1000000;
-constexpr int kMaxSceneDepth = 64;
-
-// Thrown inside the parser only and turned into a Result at the boundary: the parser is a
-// deep recursive walk and an early exit from every level would hide its logic.
-struct SceneError {
-  std::string message;
-};
-
-class Reader {
- public:
-  explicit Reader(std::string file) : file_(std::move(file)) {}
-
-  [[noreturn]] void fail(const YAML::Node& at, const std::string& what) const {
-    std::ostringstream out;
-    out << file_;
-    if (at.IsDefined() && at.Mark().line >= 0) out << ":" << at.Mark().line + 1;
-    out << ": " << what;
-    throw SceneError{out.str()};
-  }
-
-  // Every key of `map` must be in `allowed`.
-  void checkKeys(const YAML::Node& map, const std::string& where, const std::set<std::string>& allowed) const {
-    if (!map.IsMap()) fail(map, "'" + where + "' must be a mapping");
-    for (const auto& kv : map) {
-      const std::string key = kv.first.as<std::string>();
-      if (!allowed.count(key)) {
-        std::string list;
-        for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
-        fail(kv.first, "unknown key '" + key + "' in '" + where + "' (allowed: " + list + ")");
-      }
-    }
-  }
-
-  YAML::Node require(const YAML::Node& map, const std::string& key, const std::string& where) const {
-    YAML::Node n = map[key];
-    if (!n.IsDefined() || n.IsNull()) fail(map, "missing required key '" + key + "' in '" + where + "'");
-    return n;
-  }
-
-  double number(const YAML::Node& n, const std::string& key) const {
-    if (!n.IsScalar()) fail(n, "'" + key + "' must be a number");
-    double value = 0.0;
-    if (!YAML::convert<double>::decode(n, value)) fail(n, "'" + key + "' must be a number, got '" + n.Scalar() + "'");
-    if (!std::isfinite(value)) fail(n, "'" + key + "' must be finite, got '" + n.Scalar() + "'");
-    if (std::abs(value) > kMaxSceneNumber) {
-      fail(n, "'" + key + "' must be between -1e9 and 1e9, got '" + n.Scalar() + "'");
-    }
-    return value;
-  }
-  double positive(const YAML::Node& n, const std::string& key) const {
-    const double v = number(n, key);
-    if (!(v > 0.0)) fail(n, "'" + key + "' must be positive, got " + n.Scalar());
-    return v;
-  }
-  double nonNegative(const YAML::Node& n, const std::string& key) const {
-    const double v = number(n, key);
-    if (v < 0.0) fail(n, "'" + key + "' must not be negative, got " + n.Scalar());
-    return v;
-  }
-  int integer(const YAML::Node& n, const std::string& key, int lo, int hi) const {
-    if (!n.IsScalar()) fail(n, "'" + key + "' must be an integer");
-    long long value = 0;
-    if (!YAML::convert<long long>::decode(n, value)) fail(n, "'" + key + "' must be an integer, got '" + n.Scalar() + "'");
-    if (value < lo || value > hi) {
-      fail(n, "'" + key + "' must be between " + std::to_string(lo) + " and " + std::to_string(hi) + ", got " + n.Scalar());
-    }
-    return static_cast<int>(value);
-  }
-  bool boolean(const YAML::Node& n, const std::string& key) const {
-    bool value = false;
-    if (!n.IsScalar() || !YAML::convert<bool>::decode(n, value)) fail(n, "'" + key + "' must be true or false");
-    return value;
-  }
-  std::string string(const YAML::Node& n, const std::string& key) const {
-    if (!n.IsScalar()) fail(n, "'" + key + "' must be a string");
-    return n.Scalar();
-  }
-  Eigen::Vector3d vec3(const YAML::Node& n, const std::string& key) const {
-    if (!n.IsSequence() || n.size() != 3) fail(n, "'" + key + "' must be a list of 3 numbers [x, y, z]");
-    return {number(n[0], key), number(n[1], key), number(n[2], key)};
-  }
-  Eigen::Vector3d unitVec3(const YAML::Node& n, const std::string& key) const {
-    const Eigen::Vector3d v = vec3(n, key);
-    if (v.norm() < 1e-9) fail(n, "'" + key + "' must be a non-zero direction");
-    return v.normalized();
-  }
-
-  // Before any value is read: no mapping holds a key twice (YAML parsers keep one of them
-  // silently) and every scalar, keys included, is UTF-8 (names and paths go into the JSON
-  // report, whose writer refuses anything else). `where` is the path of `n` for messages.
-  void checkDocument(const YAML::Node& n, const std::string& where, int depth, long& visited) const {
-    if (++visited > kMaxSceneNodes) {
-      fail(n, "the scene expands to more than " + std::to_string(kMaxSceneNodes) + " YAML nodes (aliases?)");
-    }
-    if (depth > kMaxSceneDepth) {
-      fail(n, "'" + where + "' is nested more than " + std::to_string(kMaxSceneDepth) + " levels deep");
-    }
-    if (n.IsScalar()) {
-      checkUtf8(n, "'" + where + "'");
-    } else if (n.IsSequence()) {
-      for (std::size_t i = 0; i < n.size(); ++i) {
-        checkDocument(n[i], where + "[" + std::to_string(i) + "]", depth + 1, visited);
-      }
-    } else if (n.IsMap()) {
-      std::set<std::string> seen;
-      for (const auto& kv : n) {
-        if (!kv.first.IsScalar()) fail(kv.first, "a key in '" + where + "' is not a plain name");
-        checkUtf8(kv.first, "a key in '" + where + "'");
-        const std::string key = kv.first.Scalar();
-        if (!seen.insert(key).second) fail(kv.first, "duplicate key '" + key + "' in '" + where + "'");
-        checkDocument(kv.second, where == "scene" ? key : where + "." + key, depth + 1, visited);
-      }
-    }
-  }
-
- private:
-  void checkUtf8(const YAML::Node& n, const std::string& what) const {
-    const std::string& text = n.Scalar();
-    const std::size_t bad = firstInvalidUtf8(text);
-    if (bad == std::string::npos) return;
-    char byte[8];
-    std::snprintf(byte, sizeof byte, "0x%02x", static_cast<unsigned>(static_cast<unsigned char>(text[bad])));
-    fail(n, what + " is not valid UTF-8: byte " + byte + " at offset " + std::to_string(bad) +
-                " of the value (save the file as UTF-8)");
-  }
-
-  std::string file_;
-};
+using scene_detail::Reader;
+using scene_detail::SceneError;
 
 sim::Material parseMaterial(const Reader& r, const YAML::Node& n) {
   r.checkKeys(n, "materials[]", {"name", "label", "young_modulus_kpa", "density_g_cm3", "damping_s"});
@@ -364,13 +233,39 @@ void parseCase(const Reader& r, const YAML::Node& root, Scene& scene) {
   }
 }
 
+void parseMaterials(const Reader& r, const YAML::Node& mats, Scene& scene) {
+  if (!mats.IsSequence() || mats.size() == 0) r.fail(mats, "'materials' must be a non-empty list");
+  std::set<int> labels;
+  for (const auto& m : mats) {
+    scene.materials.push_back(parseMaterial(r, m));
+    if (!labels.insert(scene.materials.back().label).second) {
+      r.fail(m, "material label " + std::to_string(scene.materials.back().label) + " is used twice");
+    }
+  }
+}
+
+// Keyframes, or `auto`: a level-by-level resection of the organ's myomas (shaving_path.hpp).
+void parseToolPath(const Reader& r, const YAML::Node& tp, Scene& scene) {
+  if (tp.IsScalar() && tp.Scalar() == "auto") {
+    if (!scene.organ.given) r.fail(tp, "'tool_path: auto' needs an 'organ' section");
+    scene.auto_tool_path = true;
+    scene.tool_path = planShavingPath(scene.organ, scene.contact, scene.safety.perforation_margin_mm);
+    if (scene.tool_path.empty()) r.fail(tp, "'tool_path: auto' found no myoma the loop can reach (FIGO 0 to 3 or 2-5)");
+    return;
+  }
+  if (!tp.IsSequence() || tp.size() == 0) r.fail(tp, "'tool_path' must be a non-empty list of keyframes or 'auto'");
+  for (const auto& k : tp) {
+    scene.tool_path.push_back(parseKeyframe(r, k, scene.tool_path.empty() ? nullptr : &scene.tool_path.back()));
+  }
+}
+
 Scene parse(const Reader& r, const YAML::Node& root, const std::string& path) {
   Scene scene;
   scene.path = path;
   if (!root.IsDefined() || root.IsNull()) r.fail(root, "the scene file is empty");
   r.checkKeys(root, "scene", {"name", "description", "mesh", "tool_mesh", "materials", "anchors", "simulation",
                               "contact", "safety", "tool_path", "camera", "render", "chips", "cut",
-                              "coupling", "figo_type", "difficulty", "assessment"});
+                              "coupling", "figo_type", "difficulty", "assessment", "organ"});
   const fs::path dir = fs::path(path).parent_path();
   auto resolve = [&](const YAML::Node& n, const std::string& key) {
     const std::string rel = r.string(n, key);
@@ -383,18 +278,16 @@ Scene parse(const Reader& r, const YAML::Node& root, const std::string& path) {
   if (root["description"]) scene.description = r.string(root["description"], "description");
   parseCase(r, root, scene);
   if (root["assessment"]) parseAssessment(r, root["assessment"], scene.assessment);
-  scene.mesh_path = resolve(r.require(root, "mesh", "scene"), "mesh");
-  if (root["tool_mesh"]) scene.tool_mesh_path = resolve(root["tool_mesh"], "tool_mesh");
-
-  const YAML::Node mats = r.require(root, "materials", "scene");
-  if (!mats.IsSequence() || mats.size() == 0) r.fail(mats, "'materials' must be a non-empty list");
-  std::set<int> labels;
-  for (const auto& m : mats) {
-    scene.materials.push_back(parseMaterial(r, m));
-    if (!labels.insert(scene.materials.back().label).second) {
-      r.fail(m, "material label " + std::to_string(scene.materials.back().label) + " is used twice");
-    }
+  if (root["organ"]) {
+    // A generated organ brings its own materials and its anchored outer layer.
+    if (root["mesh"]) r.fail(root["mesh"], "give either 'mesh' or 'organ', not both");
+    if (root["materials"]) r.fail(root["materials"], "'materials' come from 'organ' (its young_modulus_kpa keys)");
+    scene_detail::parseOrgan(r, root["organ"], scene);
+  } else {
+    scene.mesh_path = resolve(r.require(root, "mesh", "scene"), "mesh");
+    parseMaterials(r, r.require(root, "materials", "scene"), scene);
   }
+  if (root["tool_mesh"]) scene.tool_mesh_path = resolve(root["tool_mesh"], "tool_mesh");
   if (root["anchors"]) {
     const YAML::Node an = root["anchors"];
     if (!an.IsSequence()) r.fail(an, "'anchors' must be a list");
@@ -416,10 +309,9 @@ Scene parse(const Reader& r, const YAML::Node& root, const std::string& path) {
   if (root["cut"]) parseCut(r, root["cut"], scene.cut);
   if (root["coupling"]) parseCoupling(r, root["coupling"], scene.coupling);
 
-  const YAML::Node tp = r.require(root, "tool_path", "scene");
-  if (!tp.IsSequence() || tp.size() == 0) r.fail(tp, "'tool_path' must be a non-empty list of keyframes");
-  for (const auto& k : tp) {
-    scene.tool_path.push_back(parseKeyframe(r, k, scene.tool_path.empty() ? nullptr : &scene.tool_path.back()));
+  parseToolPath(r, r.require(root, "tool_path", "scene"), scene);
+  if (scene.auto_tool_path && !(root["simulation"] && root["simulation"]["steps"])) {
+    scene.steps = static_cast<int>(std::ceil(scene.tool_path.back().time_s / scene.sim.dt));
   }
   if (root["camera"]) {
     const YAML::Node c = root["camera"];

@@ -1,4 +1,5 @@
 #include "hysim/engine/simulation.hpp"
+#include "hysim/engine/organ_mesh.hpp"
 
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
@@ -152,10 +153,15 @@ void Simulation::mapSweepRows(bool last_rows) {
 Result<std::unique_ptr<Simulation>> Simulation::create(const Scene& scene) {
   std::unique_ptr<Simulation> s(new Simulation());
   s->scene_ = scene;
-  auto mesh = cutting::readTetMesh(scene.mesh_path);
+  if (s->scene_.mesh_path.empty() && scene.organ.given) {
+    auto meshed = organMeshFile(scene.organ);
+    if (!meshed.ok()) return Error{scene.path + ": " + meshed.error()};
+    s->scene_.mesh_path = meshed->path;
+  }
+  auto mesh = cutting::readTetMesh(s->scene_.mesh_path);
   if (!mesh.ok()) return Error{mesh.error()};
   if (auto valid = cutting::validate(*mesh); !valid.ok()) {
-    return Error{scene.mesh_path + ": invalid mesh: " + valid.error()};
+    return Error{s->scene_.mesh_path + ": invalid mesh: " + valid.error()};
   }
 
   auto coupling = couplingFor(scene);

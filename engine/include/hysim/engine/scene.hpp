@@ -7,6 +7,7 @@
 
 #include "hysim/cutting/result.hpp"
 #include "hysim/engine/assessment.hpp"
+#include "hysim/engine/organ.hpp"
 #include "hysim/haptics/trajectory.hpp"
 #include "hysim/sim/model.hpp"
 
@@ -97,7 +98,9 @@ struct Scene {
   std::string figo_type;   // "0".."7" or "2-5"; empty: not given
   std::string difficulty;  // beginner, intermediate or advanced; empty: not given
   AssessmentSettings assessment;
-  std::string mesh_path;   // resolved against the scene file's folder
+  std::string mesh_path;   // resolved against the scene file's folder; empty: the organ's, meshed at load
+  OrganSpec organ;         // the `organ:` section (organ.given), instead of `mesh`
+  bool auto_tool_path = false;  // `tool_path: auto`: planned for the organ's myomas (shaving_path.hpp)
   std::string tool_mesh_path;  // optional; empty = no tool surface drawn
   std::vector<sim::Material> materials;
   std::vector<AnchorRegion> anchors;
