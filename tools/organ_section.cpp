@@ -15,7 +15,8 @@ Rgb colourAt(const engine::OrganSpec& organ, const std::vector<engine::PlacedMyo
   Rgb rgb{255, 255, 255};  // outside
   if (label == engine::kWallLabel) rgb = {214, 120, 128};
   else if (label >= engine::kFirstMyomaLabel) rgb = {238, 224, 180};
-  else if ((p.array() / c.array()).matrix().squaredNorm() < 1.0 || std::hypot(p.x(), p.y()) < organ.uterus.canal_radius_mm)
+  else if ((p.array() / c.array()).matrix().squaredNorm() < 1.0 ||
+           (p.z() < 0.0 && std::hypot(p.x(), p.y()) < organ.uterus.canal_radius_mm))
     rgb = {170, 205, 235};  // distension fluid in the cavity and the canal
   if (label != 0 && engine::organSizeAt(organ, placed, p) <= organ.mesh.fine_mm) {
     for (auto& v : rgb) v = static_cast<std::uint8_t>(v * 0.8);

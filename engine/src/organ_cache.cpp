@@ -21,7 +21,7 @@ namespace fs = std::filesystem;
 
 // Bumped whenever the mesher's output for the same organ changes (criteria, sizing, labels),
 // so that old cached meshes are not reused. With the project's version it makes the cache key.
-constexpr const char* kMesherVersion = "organ-mesher 2";
+constexpr const char* kMesherVersion = "organ-mesher 3";
 
 std::uint64_t fnv1a(const std::string& text) {
   std::uint64_t h = 1469598103934665603ull;

@@ -1,8 +1,10 @@
-// Boundary slivers: Delaunay refinement of a curved surface leaves a few flat tets whose four
+// Two clean-ups of a freshly generated mesh. Boundary slivers: Delaunay refinement of a curved surface leaves a few flat tets whose four
 // nodes all lie on the surface; perturbation and exudation cannot move surface nodes off it, so
 // they stay. Such a tet with two faces on the boundary fills a dent of almost no volume:
 // removing it leaves a valid surface.
 #include <algorithm>
+#include <array>
+#include <cstdint>
 #include <map>
 
 #include "hysim/cutting/mesh_stats.hpp"
@@ -66,7 +68,54 @@ cutting::TetMesh without(const cutting::TetMesh& mesh, const std::vector<char>& 
   return out;
 }
 
+// Interleaves the bits of three 21-bit cell coordinates (a Morton code).
+std::uint64_t morton(std::uint64_t x, std::uint64_t y, std::uint64_t z) {
+  std::uint64_t code = 0;
+  for (int b = 0; b < 21; ++b) {
+    code |= ((x >> b) & 1u) << (3 * b) | ((y >> b) & 1u) << (3 * b + 1) | ((z >> b) & 1u) << (3 * b + 2);
+  }
+  return code;
+}
+
 }  // namespace
+
+void orderForLocality(cutting::TetMesh& mesh) {
+  const Eigen::RowVector3d lo = mesh.X.colwise().minCoeff();
+  constexpr double kCellMm = 0.25;
+  std::vector<std::pair<std::uint64_t, int>> keyed(static_cast<size_t>(mesh.numNodes()));
+  for (int i = 0; i < mesh.numNodes(); ++i) {
+    const Eigen::RowVector3d c = (mesh.X.row(i) - lo) / kCellMm;
+    keyed[i] = {morton(static_cast<std::uint64_t>(c.x()), static_cast<std::uint64_t>(c.y()),
+                       static_cast<std::uint64_t>(c.z())), i};
+  }
+  std::sort(keyed.begin(), keyed.end());
+  std::vector<int> rank(static_cast<size_t>(mesh.numNodes()));
+  cutting::Positions X(mesh.numNodes(), 3);
+  for (int k = 0; k < mesh.numNodes(); ++k) {
+    rank[keyed[k].second] = k;
+    X.row(k) = mesh.X.row(keyed[k].second);
+  }
+  mesh.X = X;
+  // Tets by their smallest node, so that a tet's neighbours in memory are its neighbours.
+  std::vector<std::pair<std::array<int, 4>, int>> tets(static_cast<size_t>(mesh.numTets()));
+  for (int t = 0; t < mesh.numTets(); ++t) {
+    std::array<int, 4> n{};
+    for (int k = 0; k < 4; ++k) n[k] = rank[mesh.T(t, k)];
+    std::array<int, 4> sorted = n;
+    std::sort(sorted.begin(), sorted.end());
+    tets[t] = {sorted, t};
+  }
+  std::sort(tets.begin(), tets.end());
+  cutting::Tets T(mesh.numTets(), 4);
+  cutting::Labels material(mesh.numTets());
+  for (int e = 0; e < mesh.numTets(); ++e) {
+    const int t = tets[e].second;
+    for (int k = 0; k < 4; ++k) T(e, k) = rank[mesh.T(t, k)];  // the tet's own order keeps its orientation
+    material(e) = mesh.material(t);
+  }
+  mesh.T = T;
+  mesh.material = material;
+}
 
 int peelBoundarySlivers(cutting::TetMesh& mesh, double min_quality) {
   int removed = 0;

@@ -116,6 +116,7 @@ Result<cutting::TetMesh> meshOrgan(const OrganSpec& organ, const std::function<v
   if (c3t3.number_of_cells_in_complex() == 0) return Error{"meshing the organ gave no tetrahedra"};
   cutting::TetMesh mesh = toTetMesh(c3t3);
   peelBoundarySlivers(mesh, kPeelBelowQuality);
+  orderForLocality(mesh);
   return mesh;
 }
 

@@ -23,6 +23,10 @@ Result<cutting::TetMesh> meshOrgan(const OrganSpec& organ, const std::function<v
 // the flat surface slivers refinement leaves on curved boundaries. Returns how many went.
 int peelBoundarySlivers(cutting::TetMesh& mesh, double min_quality);
 
+// Renumbers nodes along a Morton curve of their positions, and tets by their smallest node:
+// neighbours in space become neighbours in memory, which the force loop's caches feel.
+void orderForLocality(cutting::TetMesh& mesh);
+
 // Where meshed organs are kept: $HYSIM_CACHE_DIR, else $XDG_CACHE_HOME/hysim, else
 // $HOME/.cache/hysim, else the system's temporary folder; then `organs/`.
 std::string defaultOrganCacheDir();
