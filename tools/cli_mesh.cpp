@@ -46,8 +46,9 @@ int copyTo(const std::string& from, const std::string& to) {
   fs::copy_file(from, tmp, fs::copy_options::overwrite_existing, ec);
   if (!ec) fs::rename(tmp, to, ec);
   if (ec) {
+    const std::string why = ec.message();
     fs::remove(tmp, ec);
-    std::fprintf(stderr, "hysim mesh: cannot write '%s': %s\n", to.c_str(), ec.message().c_str());
+    std::fprintf(stderr, "hysim mesh: cannot write '%s': %s\n", to.c_str(), why.c_str());
     return 1;
   }
   return 0;

@@ -101,7 +101,7 @@ void findPieces(const Tissue& base, const cutting::TetMesh& after, const cutting
 // The kept tets (free pieces leave, their volume counted as resected) and the kept nodes,
 // renumbered in their order so that the model's arrays compact in place.
 void keepAnchored(const Scene& scene, const cutting::TetMesh& after, Kept& k, PassRecord& rec) {
-  const int myoma = myomaLabel(scene);
+  const MyomaLabels myoma = myomaLabels(scene);
   k.tets.reserve(static_cast<size_t>(after.numTets()));
   for (int t = 0; t < after.numTets(); ++t) {
     if (!k.comps.free[k.comps.label[t]]) {
@@ -110,7 +110,7 @@ void keepAnchored(const Scene& scene, const cutting::TetMesh& after, Kept& k, Pa
     }
     const double vol = std::abs(cutting::tetVolume(after, t));
     rec.removed_mm3 += vol;
-    if (after.material[t] == myoma) rec.removed_myoma_mm3 += vol;
+    if (myoma.has(after.material[t])) rec.removed_myoma_mm3 += vol;
   }
   for (int c = 0; c < k.comps.count; ++c) rec.chips += k.comps.free[c] ? 1 : 0;
   rec.components = k.near_cut ? -1 : k.comps.count;
@@ -277,7 +277,7 @@ namespace {
 // positions; v (#N x 3) the velocities; on_cut (#N) marks nodes on a cut surface.
 std::vector<ChipShape> chipShapes(const cutting::TetMesh& after, const sim::NodeVectors& v,
                                   const Pieces& comps, const std::vector<std::uint8_t>& on_cut,
-                                  const std::vector<sim::Material>& materials, int myoma_label) {
+                                  const std::vector<sim::Material>& materials, const MyomaLabels& myoma) {
   std::vector<std::vector<int>> tets(static_cast<size_t>(comps.count));
   for (int t = 0; t < after.numTets(); ++t) {
     if (comps.free[comps.label[t]]) tets[comps.label[t]].push_back(t);
@@ -335,7 +335,7 @@ std::vector<ChipShape> chipShapes(const cutting::TetMesh& after, const sim::Node
           chip.material.push_back(render::SurfaceMaterial::Myoma);
         }
         chip.triangles(f, j) = vertex[p];
-        if (piece.material[face_tet[f]] != myoma_label) chip.material[vertex[p]] = render::SurfaceMaterial::Endometrium;
+        if (!myoma.has(piece.material[face_tet[f]])) chip.material[vertex[p]] = render::SurfaceMaterial::Endometrium;
       }
     }
     chip.vertices.resize(static_cast<Eigen::Index>(surface.size()), 3);
@@ -370,7 +370,7 @@ std::vector<ChipShape> chipsAt(const ChipSource& source, const Scene& scene, con
   source.remap.apply(x, v, xs, vs);
   cutting::TetMesh deformed = source.mesh;
   deformed.X = xs;
-  return chipShapes(deformed, vs, source.pieces, source.on_cut, scene.materials, myomaLabel(scene));
+  return chipShapes(deformed, vs, source.pieces, source.on_cut, scene.materials, myomaLabels(scene));
 }
 
 void runCutJob(const Tissue& base, const Scene& scene, const CutJobInput& in, CutOutcome& out) {
@@ -411,8 +411,9 @@ void runCutJob(const Tissue& base, const Scene& scene, const CutJobInput& in, Cu
   rec.cut_faces = cut->report.cut_faces;
   rec.volume_drift_mm3 = cut->report.volume_drift;
   rec.peeled_mm3 = cut->report.peeled_volume;
+  const MyomaLabels myoma = myomaLabels(scene);
   for (const cutting::MaterialVolume& m : cut->report.material_volumes)
-    if (m.label == myomaLabel(scene)) rec.volume_drift_myoma_mm3 = m.drift();
+    if (myoma.has(m.label)) rec.volume_drift_myoma_mm3 += m.drift();
 
   Kept k;
   k.anchored_after = anchorsAfter(base, scene, after, change);

@@ -171,6 +171,20 @@ void checkMyoma(const OrganSpec& organ, const PlacedMyoma& p, int k, std::vector
   }
 }
 
+// Beyond this many tets an organ would take minutes to mesh and gigabytes to hold.
+constexpr double kMaxOrganTets = 2e6;
+
+// A regular tet of edge h has volume h^3 / 8.5; Delaunay meshes come out at about that.
+double estimatedTets(const OrganSpec& organ) {
+  constexpr double kPi3 = 4.18879020478639;  // 4 pi / 3
+  const Eigen::Vector3d o = outerSemiAxes(organ.uterus), c = organ.uterus.cavity_semi_axes_mm;
+  double fine = 0.0;
+  for (const MyomaSpec& m : organ.myomas) fine += kPi3 * std::pow(0.5 * m.diameter_mm + organ.mesh.fine_band_mm, 3);
+  const double wall = kPi3 * (o.prod() - c.prod());
+  const double h = organ.mesh.fine_mm, H = organ.mesh.coarse_mm;
+  return 8.5 * (fine / (h * h * h) + wall / (H * H * H));
+}
+
 }  // namespace
 
 Eigen::Vector3d outerSemiAxes(const UterusSpec& u) {
@@ -248,6 +262,15 @@ std::vector<OrganProblem> checkOrgan(const OrganSpec& organ) {
                   0.5 * u.wall_mm);
     out.push_back({-1, "wall_mm", text});
   }
+  if (organ.mesh.fine_mm > organ.mesh.coarse_mm) {
+    out.push_back({-1, "fine_mm", "mesh.fine_mm must not be larger than mesh.coarse_mm"});
+  }
+  if (const double tets = estimatedTets(organ); tets > kMaxOrganTets) {
+    char text[200];
+    std::snprintf(text, sizeof text, "the organ would need about %.1f million tets at fine_mm %.3g (at most %.1f million):"
+                  " raise fine_mm or lower fine_band_mm", tets / 1e6, organ.mesh.fine_mm, kMaxOrganTets / 1e6);
+    out.push_back({-1, "fine_mm", text});
+  }
   if (u.canal_radius_mm > 0.8 * std::min(u.cavity_semi_axes_mm.x(), u.cavity_semi_axes_mm.y())) {
     out.push_back({-1, "canal_radius_mm", "the canal is wider than the cavity"});
   }
@@ -258,9 +281,35 @@ std::vector<OrganProblem> checkOrgan(const OrganSpec& organ) {
       const double gap = (placed[j].centre - placed[k].centre).norm() - placed[j].radius_mm - placed[k].radius_mm;
       if (gap < 1.0) {
         out.push_back({static_cast<int>(j), "wall",
-                       "the myoma overlaps myoma " + std::to_string(k + 1) + " (or is within 1 mm of it)"});
+                       "the myoma overlaps organ.myomas[" + std::to_string(k) + "] (or is within 1 mm of it)"});
       }
     }
+  }
+  return out;
+}
+
+std::vector<double> wallBehindMyomasMm(const OrganSpec& organ, const cutting::TetMesh& mesh) {
+  const std::vector<PlacedMyoma> placed = placeMyomas(organ);
+  const Eigen::Vector3d outer = outerSemiAxes(organ.uterus);
+  std::vector<char> surface(static_cast<size_t>(mesh.numNodes()), 0);
+  const cutting::Tris faces = cutting::boundaryFaces(mesh);
+  for (Eigen::Index f = 0; f < faces.rows(); ++f) {
+    for (int c = 0; c < 3; ++c) surface[faces(f, c)] = 1;
+  }
+  std::vector<double> out;
+  for (const PlacedMyoma& m : placed) {
+    double thinnest = std::numeric_limits<double>::quiet_NaN();
+    for (int i = 0; i < mesh.numNodes(); ++i) {
+      if (!surface[i]) continue;
+      const Eigen::Vector3d x = mesh.X.row(i).transpose();
+      const Eigen::Vector3d d = x - m.centre;
+      if ((d - d.dot(m.normal) * m.normal).norm() > m.radius_mm) continue;  // outside the footprint
+      if (ellipsoidLevel(x, outer) >= 1.0) continue;
+      const double wall = rayExit(x, m.normal, outer);
+      if (wall < 0.3) continue;  // a node of the serosa itself
+      if (!(wall >= thinnest)) thinnest = wall;
+    }
+    out.push_back(thinnest);
   }
   return out;
 }

@@ -11,6 +11,8 @@
 #include <pthread.h>
 #include <unistd.h>
 
+#include <CGAL/version.h>
+
 #include "hysim/cutting/mesh_io.hpp"
 #include "hysim/engine/organ_mesh.hpp"
 
@@ -20,7 +22,8 @@ namespace {
 namespace fs = std::filesystem;
 
 // Bumped whenever the mesher's output for the same organ changes (criteria, sizing, labels),
-// so that old cached meshes are not reused. With the project's version it makes the cache key.
+// so that old cached meshes are not reused. With the project's and CGAL's versions it makes
+// the cache key.
 constexpr const char* kMesherVersion = "organ-mesher 3";
 
 std::uint64_t fnv1a(const std::string& text) {
@@ -34,8 +37,8 @@ std::uint64_t fnv1a(const std::string& text) {
 
 std::string cacheName(const OrganSpec& organ) {
   char name[64];
-  std::snprintf(name, sizeof name, "organ-%016llx.msh",
-                static_cast<unsigned long long>(fnv1a(organKey(organ) + "|" + HYSIM_PROJECT_VERSION + "|" + kMesherVersion)));
+  const std::string key = organKey(organ) + "|" + HYSIM_PROJECT_VERSION + "|" + kMesherVersion + "|CGAL " + CGAL_VERSION_STR;
+  std::snprintf(name, sizeof name, "organ-%016llx.msh", static_cast<unsigned long long>(fnv1a(key)));
   return name;
 }
 
@@ -104,6 +107,16 @@ class ProgressBar {
   std::atomic<int> stage_{0};
 };
 
+// CGAL reports broken preconditions and exhausted memory by exceptions: they become errors.
+Result<cutting::TetMesh> meshWithBar(const OrganSpec& organ, bool progress) {
+  try {
+    ProgressBar bar(progress);
+    return meshOrgan(organ, [&bar](MeshStage s) { bar.setStage(s); });
+  } catch (const std::exception& e) {
+    return Error{std::string("meshing the organ failed: ") + e.what()};
+  }
+}
+
 }  // namespace
 
 const char* meshStageName(MeshStage stage) {
@@ -121,7 +134,11 @@ std::string defaultOrganCacheDir() {
   if (const char* d = std::getenv("HYSIM_CACHE_DIR"); d != nullptr && *d != '\0') base = d;
   else if (const char* x = std::getenv("XDG_CACHE_HOME"); x != nullptr && *x != '\0') base = fs::path(x) / "hysim";
   else if (const char* h = std::getenv("HOME"); h != nullptr && *h != '\0') base = fs::path(h) / ".cache" / "hysim";
-  else base = fs::temp_directory_path() / "hysim-cache";
+  else {
+    std::error_code ec;
+    const fs::path tmp = fs::temp_directory_path(ec);
+    base = (ec ? fs::path("/tmp") : tmp) / "hysim-cache";
+  }
   return (base / "organs").string();
 }
 
@@ -137,22 +154,22 @@ Result<OrganMeshFile> organMeshFile(const OrganSpec& organ, const OrganMeshOptio
   fs::create_directories(dir, ec);
   if (ec) return Error{"cannot create the organ cache folder '" + dir.string() + "': " + ec.message()};
   const auto t0 = std::chrono::steady_clock::now();
-  Result<cutting::TetMesh> mesh = [&] {
-    ProgressBar bar(options.progress);
-    return meshOrgan(organ, [&bar](MeshStage s) { bar.setStage(s); });
-  }();
+  Result<cutting::TetMesh> mesh = meshWithBar(organ, options.progress);
   if (!mesh.ok()) return Error{mesh.error()};
   out.seconds = secondsSince(t0);
   // Another process may mesh the same organ at the same time: each writes its own file.
-  const std::string tmp = out.path.substr(0, out.path.size() - 4) + ".tmp" + std::to_string(static_cast<long long>(::getpid())) + ".msh";
+  static std::atomic<int> serial{0};
+  const std::string tmp = out.path.substr(0, out.path.size() - 4) + ".tmp" + std::to_string(::getpid()) + "-" +
+                          std::to_string(serial.fetch_add(1)) + ".msh";
   if (Status st = cutting::writeMesh(tmp, *mesh); !st.ok()) {
     fs::remove(tmp, ec);
     return Error{"cannot write the organ mesh: " + st.error()};
   }
   fs::rename(tmp, out.path, ec);
   if (ec) {
+    const std::string why = ec.message();
     fs::remove(tmp, ec);
-    return Error{"cannot move the organ mesh into '" + out.path + "': " + ec.message()};
+    return Error{"cannot move the organ mesh into '" + out.path + "': " + why};
   }
   return out;
 }

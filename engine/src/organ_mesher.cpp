@@ -41,20 +41,13 @@ constexpr double kPeelBelowQuality = 0.12;
 
 // CGAL's size bounds are circumradii: of the surface Delaunay balls (facets) and of the
 // cells. An equilateral triangle's is 0.577 of its edge and a regular tet's 0.612.
-struct FacetSize {
+struct SizeBound {
   const OrganSpec* organ;
   const std::vector<PlacedMyoma>* placed;
+  double circumradius_per_edge;
   double operator()(const Point& p, int, const Domain::Index&) const {
     const double size = organSizeAt(*organ, *placed, toEigen(p));
-    return 0.577 * sizeScale(*organ, size) * size;
-  }
-};
-struct CellSize {
-  const OrganSpec* organ;
-  const std::vector<PlacedMyoma>* placed;
-  double operator()(const Point& p, int, const Domain::Index&) const {
-    const double size = organSizeAt(*organ, *placed, toEigen(p));
-    return 0.612 * sizeScale(*organ, size) * size;
+    return circumradius_per_edge * sizeScale(*organ, size) * size;
   }
 };
 
@@ -101,9 +94,9 @@ Result<cutting::TetMesh> meshOrgan(const OrganSpec& organ, const std::function<v
   Domain domain(params::function = std::function<int(const Point&)>(label),
                 params::bounding_object = K::Sphere_3(CGAL::ORIGIN, radius * radius),
                 params::relative_error_bound = 1e-6);
-  const Criteria criteria(params::facet_angle = 25, params::facet_size = FacetSize{&organ, &placed},
+  const Criteria criteria(params::facet_angle = 25, params::facet_size = SizeBound{&organ, &placed, 0.577},
                           params::facet_distance = 0.25, params::cell_radius_edge_ratio = 2.5,
-                          params::cell_size = CellSize{&organ, &placed});
+                          params::cell_size = SizeBound{&organ, &placed, 0.612});
   stage(MeshStage::Refine);
   C3t3 c3t3 = CGAL::make_mesh_3<C3t3>(domain, criteria, params::no_perturb(), params::no_exude());
   // No time limits: a limit would make the mesh depend on the machine's speed. The sliver
@@ -116,6 +109,7 @@ Result<cutting::TetMesh> meshOrgan(const OrganSpec& organ, const std::function<v
   if (c3t3.number_of_cells_in_complex() == 0) return Error{"meshing the organ gave no tetrahedra"};
   cutting::TetMesh mesh = toTetMesh(c3t3);
   peelBoundarySlivers(mesh, kPeelBelowQuality);
+  if (mesh.numTets() == 0) return Error{"meshing the organ gave no tetrahedra"};
   orderForLocality(mesh);
   return mesh;
 }

@@ -1,5 +1,6 @@
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <nlohmann/json.hpp>
 #include <vector>
@@ -73,7 +74,13 @@ std::string summaryText(const RunReport& r) {
                 "path length       %.0f mm\n",
                 s.myoma_resected_mm3, s.myoma_resected_pct, r.initial_myoma_mm3, s.healthy_removed_mm3, s.perforations,
                 r.perforation_margin_mm, s.passes, s.cut_ms_median, s.cut_ms_max, s.electrode_active_s, s.path_length_mm);
-  return buf + assessmentText(s.assessment);
+  std::string text = buf;
+  for (size_t k = 0; k < r.wall_behind_myoma_mm.size(); ++k) {
+    char line[96];
+    std::snprintf(line, sizeof line, "wall behind myoma %zu: %.1f mm to the serosa\n", k + 1, r.wall_behind_myoma_mm[k]);
+    text += line;
+  }
+  return text + assessmentText(s.assessment);
 }
 
 std::string reportJson(const RunReport& r) {
@@ -170,6 +177,11 @@ std::string reportJson(const RunReport& r) {
   j["cut_ms"] = {{"median", sum.cut_ms_median}, {"max", sum.cut_ms_max}};
   j["perforation_margin_mm"] = r.perforation_margin_mm;
   j["serosa_faces"] = r.serosa_faces;
+  if (!r.wall_behind_myoma_mm.empty()) {
+    nlohmann::ordered_json walls = nlohmann::ordered_json::array();
+    for (double w : r.wall_behind_myoma_mm) walls.push_back(std::isnan(w) ? nlohmann::ordered_json() : nlohmann::ordered_json(w));
+    j["wall_behind_myoma_mm"] = walls;
+  }
   j["perforations"] = r.perforations;
   nlohmann::ordered_json events = nlohmann::ordered_json::array();
   for (const PerforationEvent& e : r.perforation_events) {

@@ -64,6 +64,7 @@ void collect(const Simulation& sim, RunReport& r) {
   r.perforations = sim.perforations();
   r.perforation_events = sim.perforationEvents();
   r.serosa_faces = sim.outerWall().numFaces();
+  if (scene.organ.given) r.wall_behind_myoma_mm = wallBehindMyomasMm(scene.organ, sim.mesh());
   r.stalls = sim.stalls();
   r.stall_ms = sim.stallMs();
   std::vector<double> commit_us, latency_ms;

@@ -250,7 +250,7 @@ void parseToolPath(const Reader& r, const YAML::Node& tp, Scene& scene) {
     if (!scene.organ.given) r.fail(tp, "'tool_path: auto' needs an 'organ' section");
     scene.auto_tool_path = true;
     scene.tool_path = planShavingPath(scene.organ, scene.contact, scene.safety.perforation_margin_mm);
-    if (scene.tool_path.empty()) r.fail(tp, "'tool_path: auto' found no myoma the loop can reach (FIGO 0 to 3 or 2-5)");
+    if (scene.tool_path.empty()) r.fail(tp, "'tool_path: auto' found no myoma the loop can reach (FIGO 0 to 4 or 2-5)");
     return;
   }
   if (!tp.IsSequence() || tp.size() == 0) r.fail(tp, "'tool_path' must be a non-empty list of keyframes or 'auto'");

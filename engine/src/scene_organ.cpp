@@ -30,7 +30,7 @@ void parseUterus(const Reader& r, const YAML::Node& n, UterusSpec& u) {
   if (n["canal_radius_mm"]) u.canal_radius_mm = inRange(r, n["canal_radius_mm"], "canal_radius_mm", 1.0, 8.0);
   if (n["young_modulus_kpa"]) u.myometrium_kpa = inRange(r, n["young_modulus_kpa"], "young_modulus_kpa", 1.0, 1000.0);
   if (n["anchored_depth_mm"]) {
-    u.anchored_depth_mm = inRange(r, n["anchored_depth_mm"], "anchored_depth_mm", 0.0, 0.5 * u.wall_mm);
+    u.anchored_depth_mm = inRange(r, n["anchored_depth_mm"], "anchored_depth_mm", 0.5, 0.5 * u.wall_mm);
   }
 }
 
@@ -73,6 +73,10 @@ YAML::Node problemNode(const YAML::Node& organ, const OrganProblem& p) {
     const YAML::Node m = organ["myomas"][static_cast<size_t>(p.myoma)];
     return m[p.key] ? m[p.key] : m;
   }
+  // The mesh sizes' key when the scene gives it (a wall too thin for a coarse size asked).
+  const YAML::Node mesh = organ["mesh"];
+  if (p.key == "wall_mm" && mesh && mesh["coarse_mm"]) return mesh["coarse_mm"];
+  if (mesh && mesh[p.key]) return mesh[p.key];
   const YAML::Node u = organ["uterus"];
   if (u && u[p.key]) return u[p.key];
   return u ? u : organ;
@@ -111,7 +115,9 @@ void parseOrgan(const Reader& r, const YAML::Node& n, Scene& scene) {
   const std::vector<OrganProblem> problems = checkOrgan(organ);
   if (!problems.empty()) {
     const OrganProblem& p = problems.front();
-    const std::string who = p.myoma >= 0 ? "organ.myomas[" + std::to_string(p.myoma) + "]" : "organ.uterus";
+    const bool sizes = p.key == "fine_mm" || p.key == "coarse_mm";
+    const std::string who = p.myoma >= 0 ? "organ.myomas[" + std::to_string(p.myoma) + "]"
+                                         : (sizes ? "organ.mesh" : "organ.uterus");
     r.fail(problemNode(n, p), who + "." + p.key + ": " + p.message);
   }
   organMaterials(organ, scene.materials);

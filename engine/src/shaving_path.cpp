@@ -17,8 +17,14 @@ struct Scope {
   double min_tip_mm = 8.0;
 };
 
+// world_up made perpendicular to the axis; where the two are (nearly) parallel, as for a
+// fundal myoma straight ahead, anterior (or left) instead.
 Vector3d upFor(const Vector3d& axis, const Vector3d& world_up) {
-  return (world_up - world_up.dot(axis) * axis).normalized();
+  for (const Vector3d& u : {world_up, Vector3d(Vector3d::UnitY()), Vector3d(Vector3d::UnitX())}) {
+    const Vector3d perp = u - u.dot(axis) * axis;
+    if (perp.norm() > 0.2) return perp.normalized();
+  }
+  return Vector3d::UnitX();
 }
 
 // The axis through the pivot that puts the loop's lowest point on `target`.
@@ -38,7 +44,7 @@ haptics::Keyframe key(double t, const Scope& s, const Vector3d& axis, double tip
   k.time_s = t;
   k.tip = s.pivot + tip_mm * axis;
   k.axis = axis;
-  k.up = s.world_up;
+  k.up = upFor(axis, s.world_up);
   k.extension_mm = ext;
   k.pedal = pedal;
   return k;
@@ -71,8 +77,10 @@ void addPass(std::vector<haptics::Keyframe>& out, double& t, const Scope& s, con
   const double tip = std::max(s.min_tip_mm, alongTo(s, cut, target) - s.reach_mm - kMidExt);
   const double mid = alongTo(s, cut, target) - s.reach_mm - tip;
   double far = std::clamp(mid + half_len + 4.0, 0.0, kMaxExt), near = std::clamp(mid - half_len - 4.0, 0.0, far);
-  while (far > mid && toOuter(loopBottom(s, cut, tip, far), g.normal, g.outer) < g.keep_mm) far -= kStep;
-  while (near < mid && toOuter(loopBottom(s, cut, tip, near), g.normal, g.outer) < g.keep_mm) near += kStep;
+  while (far > std::max(mid, 0.0) && toOuter(loopBottom(s, cut, tip, far), g.normal, g.outer) < g.keep_mm) far -= kStep;
+  while (near < std::min(mid, far) && toOuter(loopBottom(s, cut, tip, near), g.normal, g.outer) < g.keep_mm) near += kStep;
+  far = std::max(far, 0.0);
+  near = std::clamp(near, 0.0, far);
   out.push_back(key(t + 0.20, s, over, tip, 0.0, false));
   out.push_back(key(t + 0.60, s, over, tip, far, false));
   out.push_back(key(t + 0.65, s, over, tip, far, true));

@@ -17,7 +17,7 @@ double msSince(std::chrono::steady_clock::time_point t0) {
 // its boundary faces belong to myoma tets (the rim where the myoma meets the wall keeps the
 // endometrium colour: its base is covered by endometrium in reality), as cut tissue when it
 // lies on a cut.
-void buildRenderSurface(Tissue& tissue, const Eigen::VectorXi& face_tet, int myoma_label) {
+void buildRenderSurface(Tissue& tissue, const Eigen::VectorXi& face_tet, const MyomaLabels& myoma) {
   const cutting::TetMesh& mesh = tissue.mesh;
   tissue.surface_nodes.clear();
   tissue.surface_triangles.clear();
@@ -32,7 +32,7 @@ void buildRenderSurface(Tissue& tissue, const Eigen::VectorXi& face_tet, int myo
         tissue.surface_material.push_back(render::SurfaceMaterial::Myoma);
       }
       tissue.surface_triangles.push_back(static_cast<std::uint32_t>(local[node]));
-      if (mesh.material[face_tet[f]] != myoma_label) {
+      if (!myoma.has(mesh.material[face_tet[f]])) {
         tissue.surface_material[local[node]] = render::SurfaceMaterial::Endometrium;
       }
     }
@@ -50,11 +50,12 @@ void buildRenderSurface(Tissue& tissue, const Eigen::VectorXi& face_tet, int myo
 
 }  // namespace
 
-int myomaLabel(const Scene& scene) {
+MyomaLabels myomaLabels(const Scene& scene) {
+  MyomaLabels out;
   for (const sim::Material& m : scene.materials) {
-    if (m.name == "myoma") return m.label;
+    if (m.name == "myoma") out.labels.push_back(m.label);
   }
-  return -1;
+  return out;
 }
 
 bool anchoredAt(const Scene& scene, const Eigen::Vector3d& rest) {
@@ -104,7 +105,7 @@ Status buildSurface(Tissue& tissue, const Scene& scene, const sim::NodeVectors& 
   } else {
     tissue.surface_faces = cutting::boundaryFaces(tissue.mesh, &face_tet);
   }
-  buildRenderSurface(tissue, face_tet, myomaLabel(scene));
+  buildRenderSurface(tissue, face_tet, myomaLabels(scene));
   if (timing != nullptr) timing->surface_ms += msSince(t0);
   t0 = std::chrono::steady_clock::now();
   // Boxes grown by half a millimetre: while the tissue near the loop moves less than that, a

@@ -153,7 +153,7 @@ TEST(OrganScene, BadOrgansNameTheLineAndTheKey) {
   // Overlapping myomas: the second is named.
   expectOrganError("  myomas:\n    - {figo: \"1\", diameter_mm: 16, wall: posterior}\n"
                    "    - {figo: \"2\", diameter_mm: 12, wall: posterior, angle_deg: 10}\n", 5,
-                   "organ.myomas[1].wall: the myoma overlaps myoma 1");
+                   "organ.myomas[1].wall: the myoma overlaps organ.myomas[0]");
   // A myoma wholly outside the uterus.
   expectOrganError("  myomas:\n    - {figo: \"5\", diameter_mm: 8, wall: posterior, offset_mm: 40}\n", 4,
                    "outside the uterus");

@@ -64,6 +64,17 @@ TEST(OrganMesh, ValidLabelledAndOfGoodQuality) {
   EXPECT_NEAR(myoma, 1436.8, 0.05 * 1436.8);
 }
 
+TEST(OrganMesh, WallBehindAnUncutMyomaIsTheWall) {
+  auto mesh = meshOrgan(smallOrgan());
+  ASSERT_TRUE(mesh.ok());
+  const std::vector<double> wall = wallBehindMyomasMm(smallOrgan(), *mesh);
+  ASSERT_EQ(wall.size(), 1u);
+  // Uncut, the thinnest wall under the footprint is at its rim, where the endometrium is: the
+  // 12 mm wall, a little less across the ellipsoids' curvature.
+  EXPECT_GT(wall[0], 9.0);
+  EXPECT_LT(wall[0], 12.5);
+}
+
 TEST(OrganMesh, SameOrganSameBytesAndTheCacheReturnsIt) {
   OrganMeshOptions a;
   a.cache_dir = freshDir("organ_cache_a");
@@ -102,16 +113,21 @@ TEST(OrganMesh, UnusableCacheFolderIsSaid) {
 }
 
 TEST(OrganMesh, PeelingRemovesOnlyFlatSurfaceTets) {
-  // A unit cube's six tets plus a flat tet on its top face (two faces on the boundary).
-  auto mesh = meshOrgan(smallOrgan());
-  ASSERT_TRUE(mesh.ok());
-  cutting::TetMesh m = *mesh;
-  const int before = m.numTets();
-  EXPECT_EQ(peelBoundarySlivers(m, 0.0), 0);  // nothing below quality 0
-  EXPECT_EQ(m.numTets(), before);
-  const int peeled = peelBoundarySlivers(m, 0.2);
-  EXPECT_EQ(m.numTets(), before - peeled);
+  // A regular tet and, on one of its faces, a flat tet (three faces on the boundary).
+  cutting::TetMesh m;
+  m.X.resize(5, 3);
+  m.X << 0, 0, 0, 1, 0, 0, 0.5, 0.8660254, 0, 0.5, 0.2886751, 0.8164966, 0.5, 0.2886751, -0.02;
+  m.T.resize(2, 4);
+  m.T << 0, 1, 2, 3, 0, 2, 1, 4;
+  m.material.resize(2);
+  m.material << 1, 1;
+  ASSERT_TRUE(cutting::validate(m).ok());
+  EXPECT_EQ(peelBoundarySlivers(m, 0.1), 1);
+  ASSERT_EQ(m.numTets(), 1);
+  EXPECT_EQ(m.numNodes(), 4);  // the flat tet's own node went with it
+  EXPECT_NEAR(cutting::tetVolume(m, 0), 0.11785, 1e-4);
   EXPECT_TRUE(cutting::validate(m).ok());
+  EXPECT_EQ(peelBoundarySlivers(m, 0.1), 0);  // a regular tet stays, even alone
 }
 
 TEST(OrganMesh, SimulationRunsOnAGeneratedOrgan) {

@@ -1,4 +1,5 @@
 #include "hysim/engine/accuracy/cases.hpp"
+#include "hysim/engine/organ_mesh.hpp"
 
 #include <cmath>
 #include <numbers>
@@ -106,7 +107,13 @@ std::vector<int> anteriorIndenter(const cutting::TetMesh& mesh, const std::vecto
 }  // namespace
 
 Result<AccuracyCase> organCase(const Scene& scene, const std::string& mesh_path, double indenter_radius_mm) {
-  auto mesh = cutting::readTetMesh(mesh_path.empty() ? scene.mesh_path : mesh_path);
+  std::string path = mesh_path.empty() ? scene.mesh_path : mesh_path;
+  if (path.empty() && scene.organ.given) {  // a generated organ: its cached mesh
+    auto meshed = organMeshFile(scene.organ);
+    if (!meshed.ok()) return Error{scene.path + ": " + meshed.error()};
+    path = meshed->path;
+  }
+  auto mesh = cutting::readTetMesh(path);
   if (!mesh.ok()) return Error{mesh.error()};
   AccuracyCase c;
   c.name = "organ";

@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "hysim/cutting/mesh.hpp"
+
 namespace hysim::engine {
 
 enum class MyomaWall { Anterior, Posterior, Left, Right, Fundal };
@@ -83,6 +85,12 @@ struct OrganProblem {
   std::string message;
 };
 std::vector<OrganProblem> checkOrgan(const OrganSpec& organ);
+
+// Per myoma, the thinnest wall left between the tissue's surface and the serosa under the
+// myoma's footprint (a cylinder of its radius along its normal), measured along the normal in
+// `mesh`'s rest positions: after a resection, the wall behind the crater. NaN for a myoma with
+// no surface under it.
+std::vector<double> wallBehindMyomasMm(const OrganSpec& organ, const cutting::TetMesh& mesh);
 
 // Every parameter that shapes the mesh, printed exactly (the cache's key).
 std::string organKey(const OrganSpec& organ);

@@ -91,6 +91,7 @@ struct RunReport {
   double perforation_margin_mm = 0.0;
   int perforations = 0;                            // events (see PerforationEvent)
   std::vector<PerforationEvent> perforation_events;  // the first Simulation::kMaxPerforationEvents
+  std::vector<double> wall_behind_myoma_mm;        // generated organs: organ.hpp's wallBehindMyomasMm at the end
   int serosa_faces = 0;                            // outer-surface faces the check measures against
   // Chips (scene `chips`): mode, simulated chips in the cavity at the end, chips that left
   // it, chips dropped over the cap, and the mean wall time of a chip step (Bullet), us.

@@ -3,6 +3,7 @@
 // every structure derived from them (boundary, render surface, contact nodes, collision
 // hierarchy, tet locator). A cut makes the next epoch on the cut worker; the simulation
 // swaps it in at the commit step. The state (positions, velocities) is not part of it.
+#include <algorithm>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -52,8 +53,12 @@ struct Tissue {
   Tissue& operator=(const Tissue&) = delete;
 };
 
-// The label of the material named "myoma", or -1.
-int myomaLabel(const Scene& scene);
+// The labels of the materials named "myoma" (a generated organ has one per myoma).
+struct MyomaLabels {
+  std::vector<int> labels;
+  bool has(int label) const { return std::find(labels.begin(), labels.end(), label) != labels.end(); }
+};
+MyomaLabels myomaLabels(const Scene& scene);
 // Whether a rest position lies in one of the scene's anchor regions.
 bool anchoredAt(const Scene& scene, const Eigen::Vector3d& rest);
 // q* = r_in / R_circ of tet t (rest shape).
