@@ -92,12 +92,15 @@ Result<render::SurfaceMesh> loadSurface(const std::string& path, render::Surface
 }
 
 bool Simulation::mapToRest(const Eigen::Vector3d& p, double displacement, Eigen::Vector3d& rest) const {
-  int t = tissue_->locator.locate(tissue_->mesh, state_.x, p, displacement);
+  const int t = tissue_->locator.locate(tissue_->mesh, state_.x, p, displacement);
   if (t < 0) {
+    // Outside the tissue (in the cavity): the nearest surface node's offset, carried over
+    // rigidly. Extrapolating a tet's barycentric coordinates this far out would magnify the
+    // offset by the tet's flatness and throw the cut surface's vertex across the organ.
     const int nearest = tissue_->nearest.nearest(p);
     if (nearest < 0) return false;
-    t = tissue_->node_tet[nearest];
-    if (t < 0) return false;
+    rest = tissue_->mesh.X.row(nearest).transpose() + (p - state_.x.row(nearest).transpose());
+    return true;
   }
   // Barycentric coordinates of p in tet t at positions state_.x (may lie outside [0, 1]).
   const Eigen::Vector3d a = state_.x.row(tissue_->mesh.T(t, 0)).transpose();

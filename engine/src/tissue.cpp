@@ -119,9 +119,6 @@ void buildLookups(Tissue& tissue, const sim::NodeVectors& x) {
   tissue.locator.build(tissue.mesh, x);
   tissue.nearest_x = x;
   tissue.nearest.build(tissue.nearest_x, tissue.surface_nodes);
-  tissue.node_tet.assign(static_cast<size_t>(tissue.mesh.numNodes()), -1);
-  for (int t = 0; t < tissue.mesh.numTets(); ++t)
-    for (int k = 0; k < 4; ++k) tissue.node_tet[tissue.mesh.T(t, k)] = t;
 }
 
 int findAnchorPieces(Tissue& tissue, bool count) {

@@ -46,7 +46,6 @@ struct Tissue {
   // each node. nearest refers to nearest_x and surface_nodes: a Tissue is never copied.
   sim::NodeVectors nearest_x;
   NearestPoint nearest;
-  std::vector<int> node_tet;             // #N: a tet around each node (the last that has it)
 
   Tissue() = default;
   Tissue(const Tissue&) = delete;
