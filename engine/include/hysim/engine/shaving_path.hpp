@@ -14,8 +14,8 @@
 namespace hysim::engine {
 
 struct ShavingPlan {
-  double level_step_mm = 2.0;     // between levels, along the wall's normal
-  double pass_spacing_mm = 4.0;   // between passes on a level, side to side
+  double level_step_mm = 1.5;     // between levels, along the wall's normal
+  double pass_spacing_mm = 3.0;   // between passes on a level, side to side
   double edge_mm = 1.5;           // outermost loop centres this far inside the myoma's outline
   double lift_mm = 4.0;           // the loop enters and leaves this far above the pass's depth
   double serosa_safety_mm = 2.5;  // deepest loop point: this plus the perforation margin from the serosa
