@@ -13,12 +13,6 @@ double ellipsoidLevel(const Eigen::Vector3d& p, const Eigen::Vector3d& semi) {
   return (p.array() / semi.array()).matrix().squaredNorm();
 }
 
-// Where the ray from `from` along the unit `d` leaves the ellipsoid (from inside it).
-double rayExit(const Eigen::Vector3d& from, const Eigen::Vector3d& d, const Eigen::Vector3d& semi) {
-  const Eigen::Vector3d a = (d.array() / semi.array()).matrix(), b = (from.array() / semi.array()).matrix();
-  const double qa = a.squaredNorm(), qb = 2.0 * a.dot(b), qc = b.squaredNorm() - 1.0;
-  return (-qb + std::sqrt(std::max(qb * qb - 4.0 * qa * qc, 0.0))) / (2.0 * qa);
-}
 
 // The endometrium point a myoma sits on (the cavity ellipsoid along the wall's direction).
 Eigen::Vector3d basePoint(const MyomaSpec& m, const UterusSpec& u) {
@@ -26,7 +20,7 @@ Eigen::Vector3d basePoint(const MyomaSpec& m, const UterusSpec& u) {
   const double a = m.angle_deg * kPi / 180.0;
   if (m.wall == MyomaWall::Fundal) {
     const Eigen::Vector3d d(0.0, std::sin(a), std::cos(a));
-    return d * rayExit(Eigen::Vector3d::Zero(), d, s);
+    return d * ellipsoidExitMm(Eigen::Vector3d::Zero(), d, s);
   }
   double azimuth = 0.0;  // from +x (the patient's left) towards +y (anterior)
   switch (m.wall) {
@@ -38,7 +32,7 @@ Eigen::Vector3d basePoint(const MyomaSpec& m, const UterusSpec& u) {
   const double phi = azimuth * kPi / 180.0 + a;
   const Eigen::Vector3d origin(0.0, 0.0, m.height * s.z());
   return origin + Eigen::Vector3d(std::cos(phi), std::sin(phi), 0.0) *
-                      rayExit(origin, Eigen::Vector3d(std::cos(phi), std::sin(phi), 0.0), s);
+                      ellipsoidExitMm(origin, Eigen::Vector3d(std::cos(phi), std::sin(phi), 0.0), s);
 }
 
 double stalkLength(double r) { return std::max(2.0, 0.4 * r); }
@@ -115,7 +109,7 @@ Shares sharesOf(const PlacedMyoma& m, const UterusSpec& u) {
 
 // The wall's thickness under a myoma, along the cavity's normal.
 double wallThicknessAt(const PlacedMyoma& m, const UterusSpec& u) {
-  return rayExit(m.base, m.normal, outerSemiAxes(u));
+  return ellipsoidExitMm(m.base, m.normal, outerSemiAxes(u));
 }
 
 std::string typeMismatch(const std::string& figo, const Shares& s, double gapCavity, double gapSerosa) {
@@ -186,6 +180,12 @@ double estimatedTets(const OrganSpec& organ) {
 }
 
 }  // namespace
+
+double ellipsoidExitMm(const Eigen::Vector3d& from, const Eigen::Vector3d& d, const Eigen::Vector3d& semi) {
+  const Eigen::Vector3d a = (d.array() / semi.array()).matrix(), b = (from.array() / semi.array()).matrix();
+  const double qa = a.squaredNorm(), qb = 2.0 * a.dot(b), qc = b.squaredNorm() - 1.0;
+  return (-qb + std::sqrt(std::max(qb * qb - 4.0 * qa * qc, 0.0))) / (2.0 * qa);
+}
 
 Eigen::Vector3d outerSemiAxes(const UterusSpec& u) {
   return u.cavity_semi_axes_mm + Eigen::Vector3d::Constant(u.wall_mm);
@@ -305,7 +305,7 @@ std::vector<double> wallBehindMyomasMm(const OrganSpec& organ, const cutting::Te
       const Eigen::Vector3d d = x - m.centre;
       if ((d - d.dot(m.normal) * m.normal).norm() > m.radius_mm) continue;  // outside the footprint
       if (ellipsoidLevel(x, outer) >= 1.0) continue;
-      const double wall = rayExit(x, m.normal, outer);
+      const double wall = ellipsoidExitMm(x, m.normal, outer);
       if (wall < 0.3) continue;  // a node of the serosa itself
       if (!(wall >= thinnest)) thinnest = wall;
     }

@@ -58,7 +58,6 @@ struct SerosaGuard {
   double keep_mm = 0.0;
 };
 
-double toOuter(const Vector3d& p, const Vector3d& d, const Vector3d& outer);
 
 // The loop's lowest point with the scope along `axis`, the tip `tip_mm` in, extended `ext`.
 Vector3d loopBottom(const Scope& s, const Vector3d& axis, double tip_mm, double ext) {
@@ -77,8 +76,8 @@ void addPass(std::vector<haptics::Keyframe>& out, double& t, const Scope& s, con
   const double tip = std::max(s.min_tip_mm, alongTo(s, cut, target) - s.reach_mm - kMidExt);
   const double mid = alongTo(s, cut, target) - s.reach_mm - tip;
   double far = std::clamp(mid + half_len + 4.0, 0.0, kMaxExt), near = std::clamp(mid - half_len - 4.0, 0.0, far);
-  while (far > std::max(mid, 0.0) && toOuter(loopBottom(s, cut, tip, far), g.normal, g.outer) < g.keep_mm) far -= kStep;
-  while (near < std::min(mid, far) && toOuter(loopBottom(s, cut, tip, near), g.normal, g.outer) < g.keep_mm) near += kStep;
+  while (far > std::max(mid, 0.0) && ellipsoidExitMm(loopBottom(s, cut, tip, far), g.normal, g.outer) < g.keep_mm) far -= kStep;
+  while (near < std::min(mid, far) && ellipsoidExitMm(loopBottom(s, cut, tip, near), g.normal, g.outer) < g.keep_mm) near += kStep;
   far = std::max(far, 0.0);
   near = std::clamp(near, 0.0, far);
   out.push_back(key(t + 0.20, s, over, tip, 0.0, false));
@@ -91,16 +90,10 @@ void addPass(std::vector<haptics::Keyframe>& out, double& t, const Scope& s, con
   t += 2.0;
 }
 
-// Where the ray from p (inside the outer ellipsoid) along the unit d leaves it.
-double toOuter(const Vector3d& p, const Vector3d& d, const Vector3d& outer) {
-  const Vector3d a = (d.array() / outer.array()).matrix(), b = (p.array() / outer.array()).matrix();
-  const double qa = a.squaredNorm(), qb = 2.0 * a.dot(b), qc = b.squaredNorm() - 1.0;
-  return (-qb + std::sqrt(std::max(qb * qb - 4.0 * qa * qc, 0.0))) / (2.0 * qa);
-}
 
 // The target raised towards the cavity until the serosa under it is at least `keep` away.
 Vector3d keepOffSerosa(const Vector3d& target, const Vector3d& normal, const Vector3d& outer, double keep) {
-  const double below = toOuter(target, normal, outer);
+  const double below = ellipsoidExitMm(target, normal, outer);
   return below < keep ? Vector3d(target - (keep - below) * normal) : target;
 }
 
@@ -121,7 +114,7 @@ void planMyoma(std::vector<haptics::Keyframe>& out, double& t, const OrganSpec& 
   s.world_up = -m.normal;
   const double offset = myomaOffsetMm(spec, organ.uterus);
   const Vector3d outer = outerSemiAxes(organ.uterus);
-  const double toSerosa = toOuter(m.centre, m.normal, outer);  // under the myoma's centre
+  const double toSerosa = ellipsoidExitMm(m.centre, m.normal, outer);  // under the myoma's centre
   const SerosaGuard guard{outer, m.normal, margin + plan.serosa_safety_mm};
   const double top = -std::max(m.radius_mm, offset);  // the endometrium over an intramural myoma
   double bottom = std::min(m.radius_mm - 1.0, toSerosa - margin - plan.serosa_safety_mm);

@@ -72,6 +72,9 @@ double myomaOffsetMm(const MyomaSpec& m, const UterusSpec& u);
 int organLabel(const OrganSpec& organ, const std::vector<PlacedMyoma>& placed, const Eigen::Vector3d& p);
 // The wanted edge length at p: fine near the myomas, growing linearly to coarse.
 double organSizeAt(const OrganSpec& organ, const std::vector<PlacedMyoma>& placed, const Eigen::Vector3d& p);
+// How far the ray from `from` (inside the ellipsoid with semi-axes `semi`, centred at the
+// origin) along the unit `d` goes before it leaves it, mm.
+double ellipsoidExitMm(const Eigen::Vector3d& from, const Eigen::Vector3d& d, const Eigen::Vector3d& semi);
 // Outer ellipsoid semi-axes (the serosa without subserosal myomas).
 Eigen::Vector3d outerSemiAxes(const UterusSpec& u);
 // Radius of a sphere about the origin that holds the whole organ.
